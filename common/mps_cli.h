@@ -1,0 +1,38 @@
+/* The command line every program shares:
+ *   PROGRAM CASE.yml --out DIR [--set key=value]... [--quiet] [extra options]
+ * Extra options are declared by the program as name + whether they take a
+ * value; anything else is an error naming the option. */
+#ifndef MPS_CLI_H
+#define MPS_CLI_H
+
+#include "mps_err.h"
+
+#define MPS_CLI_MAX_SETS 256
+#define MPS_CLI_MAX_EXTRA 16
+
+struct mps_cli_extra {
+    const char *name;    /* "--model" */
+    int takes_value;
+    const char *help;
+    const char *value;   /* filled: the value, or "1" for a flag given; NULL if absent */
+};
+
+struct mps_cli {
+    const char *case_path;
+    const char *out_dir;          /* NULL if --out not given */
+    const char *sets[MPS_CLI_MAX_SETS];
+    int nsets;
+    int quiet;
+};
+
+/* Parses argv. extra (may be NULL) is an array of nextra options, filled in
+ * place. "--help" prints usage (with the extras' help) to stdout and returns
+ * MPS_EINTR so main can exit 0 after it. */
+enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
+                              struct mps_cli_extra *extra, int nextra, const char *usage,
+                              struct mps_err *err);
+
+/* Creates a directory and its parents (like mkdir -p). */
+enum mps_status mps_mkdir_p(const char *path, struct mps_err *err);
+
+#endif

@@ -1,0 +1,56 @@
+/* Field output: one HDF5 file per snapshot (closed after writing, so a run
+ * that dies leaves every earlier snapshot readable), and an XDMF index that is
+ * rewritten atomically (write to a temporary file, rename) after each snapshot
+ * so ParaView can open the series at any moment.
+ *
+ * Snapshot layout (FILE = DIR/PREFIX_NNNNNN.h5):
+ *   /            attributes: time (s), step, code_version, git_rev, solver
+ *   /config      string dataset: the resolved case (YAML)
+ *   /particles/position  n x MPS_DIM float64 (m)
+ *   /particles/<field>   n or n x ncomp, float64 / int32 / uint8, attribute "units"
+ * XDMF: DIR/PREFIX.xmf, a temporal collection of Polyvertex grids. */
+#ifndef MPS_H5_H
+#define MPS_H5_H
+
+#include <stddef.h>
+
+#include "mps_dim.h"
+#include "mps_err.h"
+
+enum mps_field_type { MPS_F64, MPS_I32, MPS_U8 };
+
+struct mps_field {
+    const char *name;   /* "pressure", "velocity", "type" */
+    int ncomp;          /* 1 for scalars, MPS_DIM for vectors */
+    enum mps_field_type type;
+    const void *data;   /* n * ncomp values, borrowed */
+    const char *units;
+};
+
+struct mps_h5_series;
+
+/* Opens a series writing into dir (created if missing) with file prefix
+ * ("fluid", "solid"). solver and config_yaml are stored in every snapshot. */
+enum mps_status mps_h5_open(struct mps_h5_series **out, const char *dir, const char *prefix,
+                            const char *solver, const char *config_yaml, struct mps_err *err);
+
+/* Writes one snapshot of n particles at positions x, then updates the XDMF. */
+enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, size_t n,
+                             const double (*x)[MPS_DIM], const struct mps_field *fields,
+                             int nfields, struct mps_err *err);
+
+/* Number of snapshots written so far. */
+int mps_h5_count(const struct mps_h5_series *s);
+
+/* Closes the series (XDMF is already complete); accepts NULL, sets *s NULL. */
+void mps_h5_close(struct mps_h5_series **s);
+
+/* Writes DIR/NAME.xmf that shows several series (e.g. fluid and solid) as one
+ * scene: at each time of the first series, a spatial collection of the
+ * snapshots of every series with the nearest time. Reads the series' own .xmf
+ * indexes in dir (series_prefixes, n of them). Atomic like the per-series file. */
+enum mps_status mps_h5_write_scene_xdmf(const char *dir, const char *name,
+                                        const char *const *series_prefixes, int n,
+                                        struct mps_err *err);
+
+#endif

@@ -1,0 +1,24 @@
+/* The MPS weight function (Eq. 7) and the constants derived from the initial
+ * lattice: n0 (Eq. 8), N0 (neighbour count) and lambda (Eq. 13). */
+#ifndef MPS_KERNEL_H
+#define MPS_KERNEL_H
+
+#include "mps_dim.h"
+
+/* Eq. 7: w(r) = re/r - 1 for 0 < r <= re, else 0. */
+static inline double mps_weight(double r, double re)
+{
+    return (r > 0.0 && r < re) ? re / r - 1.0 : 0.0;
+}
+
+struct mps_lattice_consts {
+    double n0;       /* Eq. 8 on the full square lattice */
+    double lambda;   /* Eq. 13, m^2 */
+    int count;       /* neighbours inside re (N0 of the free-surface check) */
+};
+
+/* Constants for a particle inside a full square lattice of spacing l0, with
+ * effective radius re (both in m). */
+struct mps_lattice_consts mps_lattice_consts(double l0, double re);
+
+#endif

@@ -1,0 +1,52 @@
+/* O(N) neighbour search: a uniform cell list (counting sort of particles by
+ * cell) and, from it, a compact neighbour list (CSR) of all pairs closer than
+ * a radius. Cells are at least the radius wide, so a query visits the 3^d
+ * surrounding cells. The list stores j and |r_ij|^2 so operators with smaller
+ * radii can filter it without recomputing distances. */
+#ifndef MPS_NBR_H
+#define MPS_NBR_H
+
+#include <stddef.h>
+
+#include "mps_dim.h"
+#include "mps_err.h"
+
+struct mps_nbr_grid {
+    double lo[MPS_DIM];   /* lower corner of the bounding box */
+    double cell;          /* cell width (>= the search radius) */
+    int dims[MPS_DIM];    /* cells per axis */
+    size_t ncells;
+    size_t *cell_start;   /* ncells + 1 offsets into sorted */
+    size_t *sorted;       /* particle indices, grouped by cell */
+    size_t *cell_of;      /* cell index of each particle */
+    size_t n, cap_n, cap_cells;
+};
+
+struct mps_nbr_list {
+    size_t n;             /* particles */
+    size_t *start;        /* n + 1 offsets */
+    int *j;               /* neighbour index */
+    double *r2;           /* squared distance */
+    size_t cap_n, cap_pairs;
+    double radius;
+};
+
+/* Bins n particles into cells of width cell. Positions must be finite: a NaN
+ * or infinite coordinate is reported as MPS_EDIVERGED naming the particle. */
+enum mps_status mps_nbr_grid_build(struct mps_nbr_grid *g, size_t n, const double (*x)[MPS_DIM],
+                                   double cell, struct mps_err *err);
+void mps_nbr_grid_free(struct mps_nbr_grid *g);
+
+/* All j != i with |x_i - x_j| < radius (radius <= grid cell), for the first
+ * nquery particles (queries over all n particles of the grid). The list of
+ * each i is sorted by j (deterministic, cache-friendly). OpenMP-parallel. */
+enum mps_status mps_nbr_list_build(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
+                                   const double (*x)[MPS_DIM], size_t nquery, double radius,
+                                   struct mps_err *err);
+void mps_nbr_list_free(struct mps_nbr_list *l);
+
+/* Permutation that orders particles by cell (for mps_particles_permute):
+ * perm[k] = old index of the k-th particle. perm has g->n entries. */
+void mps_nbr_cell_order(const struct mps_nbr_grid *g, size_t *perm);
+
+#endif

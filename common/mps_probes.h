@@ -1,0 +1,18 @@
+/* probes.csv: a header row "time,<name>,..." and one row per probe interval.
+ * Each row is flushed as written, so the file is complete up to the last row
+ * if the process dies. */
+#ifndef MPS_PROBES_H
+#define MPS_PROBES_H
+
+#include "mps_err.h"
+
+struct mps_probes;
+
+enum mps_status mps_probes_open(struct mps_probes **out, const char *path,
+                                const char *const *names, int n, struct mps_err *err);
+/* One row: time then n values (%.9g). */
+enum mps_status mps_probes_write(struct mps_probes *p, double time, const double *values,
+                                 struct mps_err *err);
+void mps_probes_close(struct mps_probes **p);
+
+#endif

@@ -1,0 +1,20 @@
+/* Terminal progress for long runs: simulated time, steps/s and ETA on one
+ * line of stderr, refreshed at most once a second; silent when quiet. */
+#ifndef MPS_PROGRESS_H
+#define MPS_PROGRESS_H
+
+struct mps_progress {
+    int quiet;
+    const char *label;
+    double wall_start, wall_last;
+    double end_time;
+    long steps_at_last;
+    int printed;
+};
+
+void mps_progress_init(struct mps_progress *p, const char *label, double end_time, int quiet);
+void mps_progress_update(struct mps_progress *p, double time, long step);
+/* Prints the final line (with newline) if anything was printed. */
+void mps_progress_finish(struct mps_progress *p, double time, long step);
+
+#endif

@@ -1,0 +1,55 @@
+/* Sparse symmetric positive definite solves for the pressure Poisson equation.
+ * The PPE matrix changes every step (particles move, neighbours change), so
+ * each call gives a new matrix; solvers may keep state between calls (a
+ * CHOLMOD symbolic analysis, preconditioner work arrays) and reuse what is
+ * still valid. Methods are selectable by name from the case file
+ * (fluid.ppe_solver) so their cost can be measured against each other. */
+#ifndef FLUID_LINSOLVE_H
+#define FLUID_LINSOLVE_H
+
+#include <stddef.h>
+
+#include "mps_err.h"
+
+/* Symmetric matrix in CSR with both triangles stored, rows sorted by column,
+ * the diagonal present in every row. Row i has columns col[rowptr[i]..rowptr[i+1]). */
+struct fluid_csr {
+    int n;
+    const int *rowptr;   /* n + 1 */
+    const int *col;
+    const double *val;
+};
+
+struct fluid_linsolve_stats {
+    int iterations;      /* 0 for direct methods */
+    double residual;     /* final ||b - Ax|| / ||b|| */
+    double t_analyse;    /* s: symbolic analysis / ordering (0 when reused) */
+    double t_factor;     /* s: numeric factorisation or preconditioner setup */
+    double t_solve;      /* s: triangular solves or iterations */
+};
+
+struct fluid_linsolve;
+
+/* method: "pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse" (keeps the
+ * fill-reducing ordering while the matrix size and pattern allow), "auto"
+ * (the measured default). rtol: relative residual for iterative methods.
+ * max_iter: iteration cap (an iterative solve that hits it fails with
+ * MPS_ESOLVE naming the residual reached). */
+enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *method,
+                                      double rtol, int max_iter, int nthreads,
+                                      struct mps_err *err);
+
+/* Solves A x = b. On entry x holds the initial guess (iterative methods start
+ * from it: warm start from the previous step's pressure); on exit the
+ * solution. */
+enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct fluid_csr *A,
+                                     const double *b, double *x,
+                                     struct fluid_linsolve_stats *stats, struct mps_err *err);
+
+const char *fluid_linsolve_method(const struct fluid_linsolve *s);
+/* Comma-separated list of the method names, for error messages and docs. */
+const char *fluid_linsolve_methods(void);
+
+void fluid_linsolve_destroy(struct fluid_linsolve **s);
+
+#endif
