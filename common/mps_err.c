@@ -20,13 +20,15 @@ enum mps_status mps_err_prefix(struct mps_err *e, const char *fmt, ...)
 {
     if (!e)
         return MPS_OK;
-    char head[512], old[sizeof e->msg];
+    char head[256], old[sizeof e->msg];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(head, sizeof head, fmt, ap);
     va_end(ap);
     memcpy(old, e->msg, sizeof old);
-    snprintf(e->msg, sizeof e->msg, "%s%s", head, old);
+    size_t hl = strlen(head);
+    memcpy(e->msg, head, hl);
+    snprintf(e->msg + hl, sizeof e->msg - hl, "%.*s", (int)(sizeof e->msg - hl - 1), old);
     return e->code;
 }
 

@@ -9,6 +9,7 @@ struct mps_json {
     FILE *f;
     int depth;
     int first[32];   /* per level: no member written yet */
+    char array[32];  /* per level: 1 in an array, 0 in an object (how to close it) */
 };
 
 void mps_json_begin(struct mps_json *j, FILE *f);     /* opens the root object */

@@ -186,6 +186,57 @@ enum mps_status mps_nbr_list_build(struct mps_nbr_list *l, const struct mps_nbr_
     return MPS_OK;
 }
 
+enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+                                    const double (*x)[MPS_DIM], double radius,
+                                    struct mps_err *err)
+{
+    const size_t n = src->n;
+    const double r2max = radius * radius;
+    if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
+    dst->n = n;
+    dst->radius = radius;
+    dst->start[0] = 0;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        size_t m = 0;
+        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+            int j = src->j[k];
+            double r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = x[j][d] - x[i][d];
+                r2 += dx * dx;
+            }
+            m += r2 < r2max;
+        }
+        dst->start[i + 1] = m;
+    }
+    for (size_t i = 0; i < n; i++)
+        dst->start[i + 1] += dst->start[i];
+    size_t npairs = dst->start[n], cap = dst->cap_pairs, cap2 = dst->cap_pairs;
+    if (grow((void **)&dst->j, &cap, npairs + 1, sizeof(int)) ||
+        grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
+    dst->cap_pairs = cap < cap2 ? cap : cap2;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        size_t m = dst->start[i];
+        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+            int j = src->j[k];
+            double r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = x[j][d] - x[i][d];
+                r2 += dx * dx;
+            }
+            if (r2 < r2max) {
+                dst->j[m] = j;
+                dst->r2[m++] = r2;
+            }
+        }
+    }
+    return MPS_OK;
+}
+
 void mps_nbr_list_free(struct mps_nbr_list *l)
 {
     free(l->start);

@@ -45,6 +45,13 @@ enum mps_status mps_nbr_list_build(struct mps_nbr_list *l, const struct mps_nbr_
                                    struct mps_err *err);
 void mps_nbr_list_free(struct mps_nbr_list *l);
 
+/* The pairs of src that are closer than radius at positions x (which may have
+ * moved since src was built: r2 is recomputed), kept in src's order. Used to
+ * derive a short-radius list from a long-radius list with a skin. */
+enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+                                    const double (*x)[MPS_DIM], double radius,
+                                    struct mps_err *err);
+
 /* Permutation that orders particles by cell (for mps_particles_permute):
  * perm[k] = old index of the k-th particle. perm has g->n entries. */
 void mps_nbr_cell_order(const struct mps_nbr_grid *g, size_t *perm);

@@ -1,0 +1,19 @@
+/* Case keys every program shares (see mps_case.h). */
+#include "mps_case.h"
+
+const struct mps_key_spec mps_case_common_keys[] = {
+    {"dp", MPS_KEY_DOUBLE, NULL, 0, 0, MPS_KEY_REQUIRED | MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
+     "m", "initial particle spacing"},
+    {"end_time", MPS_KEY_DOUBLE, NULL, 0, 0, MPS_KEY_REQUIRED | MPS_KEY_LO_OPEN | MPS_KEY_NO_HI,
+     NULL, "s", "simulated time to run"},
+    {"gravity.x", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | MPS_KEY_NO_HI, NULL, "m/s^2",
+     "gravity, x component"},
+    {"gravity.y", MPS_KEY_DOUBLE, "-9.81", 0, 0, MPS_KEY_NO_LO | MPS_KEY_NO_HI, NULL, "m/s^2",
+     "gravity, y component"},
+    {"output.interval", MPS_KEY_DOUBLE, "0.05", 0, 0, MPS_KEY_NO_HI, NULL, "s",
+     "time between HDF5 snapshots (0: no snapshots)"},
+    {"output.probe_interval", MPS_KEY_DOUBLE, "0.001", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI,
+     NULL, "s", "time between probes.csv rows"},
+    {"description", MPS_KEY_STRING, "", 0, 0, 0, NULL, "", "free text"},
+    {.name = NULL},
+};

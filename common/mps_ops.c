@@ -1,0 +1,243 @@
+#include "mps_ops.h"
+
+#include <math.h>
+
+#include "mps_kernel.h"
+
+#define USE(in, j) (!(in)->use || (in)->use[j])
+#define QUERY(in, i) (!(in)->query || (in)->query[i])
+
+void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double re2 = in->re * in->re;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nl->n; i++) {
+        if (!QUERY(in, i))
+            continue;
+        double s = 0.0;
+        int c = 0;
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            int j = nl->j[k];
+            if (!USE(in, j))
+                continue;
+            double r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = in->x[j][d] - in->x[i][d];
+                r2 += dx * dx;
+            }
+            if (r2 < re2) {
+                s += mps_weight(sqrt(r2), in->re);
+                c++;
+            }
+        }
+        n[i] = s;
+        if (count)
+            count[i] = c;
+    }
+}
+
+void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda,
+                           const double (*f)[MPS_DIM], double (*lap)[MPS_DIM])
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double re2 = in->re * in->re, coef = 2.0 * MPS_DIM / (lambda * n0);
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nl->n; i++) {
+        if (!QUERY(in, i))
+            continue;
+        double acc[MPS_DIM] = {0};
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            int j = nl->j[k];
+            if (!USE(in, j))
+                continue;
+            double r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = in->x[j][d] - in->x[i][d];
+                r2 += dx * dx;
+            }
+            if (r2 >= re2)
+                continue;
+            double w = mps_weight(sqrt(r2), in->re);
+            for (int d = 0; d < MPS_DIM; d++)
+                acc[d] += (f[j][d] - f[i][d]) * w;
+        }
+        for (int d = 0; d < MPS_DIM; d++)
+            lap[i][d] = coef * acc[d];
+    }
+}
+
+void mps_ops_laplacian(const struct mps_ops_in *in, double n0, double lambda, const double *f,
+                       double *lap)
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double re2 = in->re * in->re, coef = 2.0 * MPS_DIM / (lambda * n0);
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nl->n; i++) {
+        if (!QUERY(in, i))
+            continue;
+        double acc = 0.0;
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            int j = nl->j[k];
+            if (!USE(in, j))
+                continue;
+            double r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = in->x[j][d] - in->x[i][d];
+                r2 += dx * dx;
+            }
+            if (r2 < re2)
+                acc += (f[j] - f[i]) * mps_weight(sqrt(r2), in->re);
+        }
+        lap[i] = coef * acc;
+    }
+}
+
+/* The reference value subtracted from f_j: f_i, or the neighbourhood minimum. */
+static double grad_ref(const struct mps_ops_in *in, size_t i, const double *f, int use_min)
+{
+    double ref = f[i];
+    if (!use_min)
+        return ref;
+    const struct mps_nbr_list *nl = in->nl;
+    const double re2 = in->re * in->re;
+    for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+        int j = nl->j[k];
+        if (!USE(in, j) || f[j] >= ref)
+            continue;
+        double r2 = 0.0;
+        for (int d = 0; d < MPS_DIM; d++) {
+            double dx = in->x[j][d] - in->x[i][d];
+            r2 += dx * dx;
+        }
+        if (r2 < re2)
+            ref = f[j];
+    }
+    return ref;
+}
+
+/* Sums over the neighbours of i: g = sum (f_j - ref) e_ij / r w, and, if m is
+ * not NULL, m = sum e_ij (x) e_ij w and the sum of weights. */
+static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, double ref,
+                        double g[MPS_DIM], double m[MPS_DIM][MPS_DIM])
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double re2 = in->re * in->re;
+    double wsum = 0.0;
+    for (int a = 0; a < MPS_DIM; a++) {
+        g[a] = 0.0;
+        if (m)
+            for (int b = 0; b < MPS_DIM; b++)
+                m[a][b] = 0.0;
+    }
+    for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+        int j = nl->j[k];
+        if (!USE(in, j))
+            continue;
+        double dx[MPS_DIM], r2 = 0.0;
+        for (int d = 0; d < MPS_DIM; d++) {
+            dx[d] = in->x[j][d] - in->x[i][d];
+            r2 += dx[d] * dx[d];
+        }
+        if (r2 >= re2 || r2 <= 0.0)
+            continue;
+        double r = sqrt(r2), w = mps_weight(r, in->re);
+        double s = (f[j] - ref) * w / r2; /* (f_j-ref)/r * e * w = (f_j-ref) dx w / r^2 */
+        for (int a = 0; a < MPS_DIM; a++)
+            g[a] += s * dx[a];
+        if (m)
+            for (int a = 0; a < MPS_DIM; a++)
+                for (int b = 0; b < MPS_DIM; b++)
+                    m[a][b] += dx[a] * dx[b] / r2 * w;
+        wsum += w;
+    }
+    return wsum;
+}
+
+void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, int use_min,
+                      double (*grad)[MPS_DIM])
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double coef = MPS_DIM / n0;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nl->n; i++) {
+        if (!QUERY(in, i))
+            continue;
+        double g[MPS_DIM];
+        grad_sums(in, i, f, grad_ref(in, i, f, use_min), g, NULL);
+        for (int a = 0; a < MPS_DIM; a++)
+            grad[i][a] = coef * g[a];
+    }
+}
+
+void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const double *f,
+                                int use_min, double cond_floor, double (*grad)[MPS_DIM],
+                                unsigned char *fallback)
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double coef = MPS_DIM / n0;
+#if MPS_DIM == 2
+    /* On a full lattice M = (1/n) sum e(x)e w = I/d, so det M = 1/d^2. */
+    const double det_full = 1.0 / (MPS_DIM * MPS_DIM);
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nl->n; i++) {
+        if (!QUERY(in, i))
+            continue;
+        double g[2], m[2][2];
+        double ref = grad_ref(in, i, f, use_min);
+        double wsum = grad_sums(in, i, f, ref, g, m);
+        double det = 0.0;
+        if (wsum > 0.0) {
+            /* Eq. 14-15: A = M^-1 with M normalised by n_i; the 1/n_i of the
+             * bracket in Eq. 14 cancels against it. */
+            for (int a = 0; a < 2; a++)
+                for (int b = 0; b < 2; b++)
+                    m[a][b] /= wsum;
+            det = m[0][0] * m[1][1] - m[0][1] * m[1][0];
+        }
+        if (det > cond_floor * det_full) {
+            double inv00 = m[1][1] / det, inv11 = m[0][0] / det, inv01 = -m[0][1] / det;
+            grad[i][0] = (inv00 * g[0] + inv01 * g[1]) / wsum;
+            grad[i][1] = (inv01 * g[0] + inv11 * g[1]) / wsum;
+            if (fallback)
+                fallback[i] = 0;
+        } else {
+            grad[i][0] = coef * g[0];
+            grad[i][1] = coef * g[1];
+            if (fallback)
+                fallback[i] = 1;
+        }
+    }
+#else
+#error "mps_ops_gradient_corrected: only MPS_DIM == 2 is implemented"
+#endif
+}
+
+void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f)[MPS_DIM],
+                        double *div)
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const double re2 = in->re * in->re, coef = MPS_DIM / n0;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nl->n; i++) {
+        if (!QUERY(in, i))
+            continue;
+        double acc = 0.0;
+        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
+            int j = nl->j[k];
+            if (!USE(in, j))
+                continue;
+            double dx[MPS_DIM], r2 = 0.0, dot = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                dx[d] = in->x[j][d] - in->x[i][d];
+                r2 += dx[d] * dx[d];
+            }
+            if (r2 >= re2 || r2 <= 0.0)
+                continue;
+            for (int d = 0; d < MPS_DIM; d++)
+                dot += (f[j][d] - f[i][d]) * dx[d];
+            acc += dot / r2 * mps_weight(sqrt(r2), in->re);
+        }
+        div[i] = coef * acc;
+    }
+}

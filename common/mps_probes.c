@@ -1,0 +1,95 @@
+#include "mps_probes.h"
+
+#include <errno.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+struct mps_probes {
+    FILE *f;
+    int n;
+    char *path;
+};
+
+/* A header cell, quoted (RFC 4180) only when it needs to be. */
+static void csv_cell(FILE *f, const char *s)
+{
+    if (!strpbrk(s, ",\"\r\n")) {
+        fputs(s, f);
+        return;
+    }
+    fputc('"', f);
+    for (; *s; s++) {
+        if (*s == '"')
+            fputc('"', f);
+        fputc(*s, f);
+    }
+    fputc('"', f);
+}
+
+/* Flushes and reports a write error; the row is on disk when this returns OK. */
+static enum mps_status flush_row(struct mps_probes *p, struct mps_err *err)
+{
+    if (fflush(p->f) != 0 || ferror(p->f)) {
+        int e = errno;
+        clearerr(p->f);
+        return mps_err_set(err, MPS_EIO, "cannot write '%s': %s", p->path, strerror(e));
+    }
+    return MPS_OK;
+}
+
+enum mps_status mps_probes_open(struct mps_probes **out, const char *path,
+                                const char *const *names, int n, struct mps_err *err)
+{
+    *out = NULL;
+    if (n < 0 || (n > 0 && !names))
+        return mps_err_set(err, MPS_EINPUT, "%s: bad probe list (%d probes)", path, n);
+    struct mps_probes *p = calloc(1, sizeof *p);
+    size_t len = strlen(path) + 1;
+    if (!p || !(p->path = malloc(len))) {
+        free(p);
+        return mps_err_set(err, MPS_ENOMEM, "%s: out of memory", path);
+    }
+    memcpy(p->path, path, len);
+    p->n = n;
+    if (!(p->f = fopen(path, "w"))) {
+        enum mps_status st =
+            mps_err_set(err, MPS_EIO, "cannot create '%s': %s", path, strerror(errno));
+        mps_probes_close(&p);
+        return st;
+    }
+    fputs("time", p->f);
+    for (int k = 0; k < n; k++) {
+        fputc(',', p->f);
+        csv_cell(p->f, names[k] ? names[k] : "");
+    }
+    fputc('\n', p->f);
+    enum mps_status st = flush_row(p, err);
+    if (st != MPS_OK) {
+        mps_probes_close(&p);
+        return st;
+    }
+    *out = p;
+    return MPS_OK;
+}
+
+enum mps_status mps_probes_write(struct mps_probes *p, double time, const double *values,
+                                 struct mps_err *err)
+{
+    fprintf(p->f, "%.9g", time);
+    for (int k = 0; k < p->n; k++)
+        fprintf(p->f, ",%.9g", values[k]);
+    fputc('\n', p->f);
+    return flush_row(p, err);
+}
+
+void mps_probes_close(struct mps_probes **p)
+{
+    if (!p || !*p)
+        return;
+    if ((*p)->f)
+        fclose((*p)->f);
+    free((*p)->path);
+    free(*p);
+    *p = NULL;
+}

@@ -1,0 +1,217 @@
+/* Neighbour search against brute force O(N^2), and the lattice constants of
+ * the MPS weight against hand sums. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "../test_util.h"
+#include "mps_kernel.h"
+#include "mps_nbr.h"
+
+/* Compares the CSR list of the first nquery particles with a brute-force
+ * search computing r2 the same way (so the values are bit-identical). */
+static void compare(const char *what, size_t n, const double (*x)[MPS_DIM], size_t nquery,
+                    double cell, double radius)
+{
+    struct mps_nbr_grid g = {0};
+    struct mps_nbr_list l = {0};
+    struct mps_err err = {0};
+    enum mps_status st = mps_nbr_grid_build(&g, n, x, cell, &err);
+    CHECK(st == MPS_OK);
+    if (st == MPS_OK)
+        st = mps_nbr_list_build(&l, &g, x, nquery, radius, &err);
+    CHECK(st == MPS_OK);
+    if (st != MPS_OK) {
+        fprintf(stderr, "%s: %s\n", what, err.msg);
+        goto done;
+    }
+    CHECK(l.n == nquery);
+    CHECK(l.start[0] == 0);
+    double r2max = radius * radius;
+    size_t bad = 0, total = 0;
+    int *want = malloc(n * sizeof *want + 1);
+    double *want_r2 = malloc(n * sizeof *want_r2 + 1);
+    for (size_t i = 0; i < nquery; i++) {
+        size_t m = 0;
+        for (size_t j = 0; j < n; j++) {
+            if (j == i)
+                continue;
+            double dx = x[j][0] - x[i][0], dy = x[j][1] - x[i][1];
+            double r2 = dx * dx + dy * dy;
+            if (r2 < r2max) {
+                want[m] = (int)j;
+                want_r2[m++] = r2;
+            }
+        }
+        total += m;
+        size_t got = l.start[i + 1] - l.start[i];
+        if (got != m) {
+            if (bad++ < 5)
+                fprintf(stderr, "%s: particle %zu has %zu neighbours, brute force %zu\n", what,
+                        i, got, m);
+            continue;
+        }
+        for (size_t k = 0; k < m; k++)
+            if (l.j[l.start[i] + k] != want[k] || l.r2[l.start[i] + k] != want_r2[k]) {
+                if (bad++ < 5)
+                    fprintf(stderr, "%s: particle %zu entry %zu: j %d r2 %g, want j %d r2 %g\n",
+                            what, i, k, l.j[l.start[i] + k], l.r2[l.start[i] + k], want[k],
+                            want_r2[k]);
+                break;
+            }
+    }
+    CHECK(bad == 0);
+    CHECK(l.start[nquery] == total);
+    if (bad)
+        fprintf(stderr, "%s: %zu particles differ\n", what, bad);
+    free(want);
+    free(want_r2);
+done:
+    mps_nbr_list_free(&l);
+    mps_nbr_grid_free(&g);
+}
+
+static double urand(unsigned long long *s)
+{
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) * (1.0 / 9007199254740992.0);
+}
+
+static void test_random(void)
+{
+    const size_t n = 2000;
+    const double l0 = 0.01;
+    double (*x)[MPS_DIM] = malloc(n * sizeof *x);
+    unsigned long long seed = 12345;
+    /* about one particle per l0^2, like a fluid at rest, over a 50 x 40 box */
+    for (size_t i = 0; i < n; i++) {
+        x[i][0] = -0.2 + 50 * l0 * urand(&seed);
+        x[i][1] = 0.3 + 40 * l0 * urand(&seed);
+    }
+    const double (*cx)[MPS_DIM] = (const double(*)[MPS_DIM])x;
+    compare("random re=2.1", n, cx, n, 2.1 * l0, 2.1 * l0);
+    compare("random re=4.0", n, cx, n, 4.0 * l0, 4.0 * l0);
+    compare("random re=2.1 in 4.0 cells", n, cx, n, 4.0 * l0, 2.1 * l0);
+    compare("random first 500", n, cx, 500, 2.1 * l0, 2.1 * l0);
+    /* a clustered cloud: many particles per cell */
+    for (size_t i = 0; i < n; i++) {
+        x[i][0] = 5 * l0 * urand(&seed);
+        x[i][1] = 5 * l0 * urand(&seed);
+    }
+    compare("dense re=2.1", n, cx, n, 2.1 * l0, 2.1 * l0);
+    free(x);
+}
+
+/* Lattice with particles exactly on cell borders: the grid starts half a
+ * cell below the lowest particle, so with cell = 2 l0 every odd lattice line
+ * and with cell = 4 l0 every even one lies on a border. */
+static void test_lattice(double l0, double x0)
+{
+    const int nx = 40, ny = 30;
+    size_t n = (size_t)nx * ny;
+    double (*x)[MPS_DIM] = malloc(n * sizeof *x);
+    for (int b = 0; b < ny; b++)
+        for (int a = 0; a < nx; a++) {
+            x[b * nx + a][0] = x0 + a * l0;
+            x[b * nx + a][1] = x0 + b * l0;
+        }
+    const double (*cx)[MPS_DIM] = (const double(*)[MPS_DIM])x;
+    char what[64];
+    const double radii[] = {2.1, 4.0, 2.0, 1.0};
+    for (int k = 0; k < 4; k++) {
+        snprintf(what, sizeof what, "lattice l0=%g re=%g", l0, radii[k]);
+        compare(what, n, cx, n, radii[k] * l0, radii[k] * l0);
+    }
+
+    /* n0 of an interior particle from the list equals the lattice constant */
+    struct mps_nbr_grid g = {0};
+    struct mps_nbr_list l = {0};
+    struct mps_err err = {0};
+    double re = 2.1 * l0;
+    CHECK(mps_nbr_grid_build(&g, n, cx, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&l, &g, cx, n, re, &err) == MPS_OK);
+    size_t i = (size_t)(ny / 2) * nx + nx / 2;
+    double n0 = 0.0;
+    for (size_t k = l.start[i]; k < l.start[i + 1]; k++)
+        n0 += mps_weight(sqrt(l.r2[k]), re);
+    struct mps_lattice_consts c = mps_lattice_consts(l0, re);
+    CHECK(l.start[i + 1] - l.start[i] == (size_t)c.count);
+    CHECK_NEAR(n0, c.n0, 1e-12 * c.n0);
+    mps_nbr_list_free(&l);
+    mps_nbr_grid_free(&g);
+    free(x);
+}
+
+static void test_errors(void)
+{
+    double x[10][MPS_DIM];
+    for (int i = 0; i < 10; i++)
+        x[i][0] = x[i][1] = i;
+    x[5][1] = NAN;
+    struct mps_nbr_grid g = {0};
+    struct mps_err err = {0};
+    CHECK(mps_nbr_grid_build(&g, 10, (const double(*)[MPS_DIM])x, 1.0, &err) == MPS_EDIVERGED);
+    CHECK(strstr(err.msg, "particle 5") != NULL);
+    x[5][1] = INFINITY;
+    CHECK(mps_nbr_grid_build(&g, 10, (const double(*)[MPS_DIM])x, 1.0, &err) == MPS_EDIVERGED);
+    x[5][1] = 5.0;
+    CHECK(mps_nbr_grid_build(&g, 10, (const double(*)[MPS_DIM])x, 1.0, &err) == MPS_OK);
+    struct mps_nbr_list l = {0};
+    CHECK(mps_nbr_list_build(&l, &g, (const double(*)[MPS_DIM])x, 10, 2.0, &err) == MPS_EINPUT);
+    /* no particles at all */
+    CHECK(mps_nbr_grid_build(&g, 0, NULL, 1.0, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&l, &g, NULL, 0, 1.0, &err) == MPS_OK);
+    CHECK(l.n == 0 && l.start[0] == 0);
+    mps_nbr_list_free(&l);
+    mps_nbr_grid_free(&g);
+}
+
+static void test_kernel(void)
+{
+    const double l0 = 0.02;
+    /* re = 2.1 l0: 4 at l0, 4 at sqrt2 l0, 4 at 2 l0 (w = re/r - 1); the 8 at
+     * sqrt5 l0 = 2.236 l0 lie outside re, so N0 = 12. */
+    struct mps_lattice_consts c = mps_lattice_consts(l0, 2.1 * l0);
+    CHECK(c.count == 12);
+    double n0 = 4 * (2.1 / 1.0 - 1) + 4 * (2.1 / sqrt(2.0) - 1) + 4 * (2.1 / 2.0 - 1);
+    CHECK_NEAR(c.n0, n0, 1e-12 * n0);
+    double lam = l0 * l0 *
+                 (4 * 1 * (2.1 / 1.0 - 1) + 4 * 2 * (2.1 / sqrt(2.0) - 1) +
+                  4 * 4 * (2.1 / 2.0 - 1)) / n0;
+    CHECK_NEAR(c.lambda, lam, 1e-12 * lam);
+
+    /* re = 4.0 l0: lambda = sum r^2 w / sum w over the lattice, summed here */
+    double re = 4.0 * l0, sw = 0.0, sr2w = 0.0;
+    int count = 0;
+    for (int a = -6; a <= 6; a++)
+        for (int b = -6; b <= 6; b++) {
+            double r = l0 * hypot(a, b);
+            if ((a || b) && r < re) {
+                double w = re / r - 1.0;
+                sw += w;
+                sr2w += r * r * w;
+                count++;
+            }
+        }
+    c = mps_lattice_consts(l0, re);
+    CHECK(c.count == count);
+    CHECK(count == 44); /* 0 < a^2 + b^2 < 16: 7 + 2*7 + 2*7 + 2*5 - 1 */
+    CHECK_NEAR(c.n0, sw, 1e-12 * sw);
+    CHECK_NEAR(c.lambda, sr2w / sw, 1e-12 * sr2w / sw);
+
+    CHECK(mps_weight(0.0, re) == 0.0);
+    CHECK(mps_weight(re, re) == 0.0);
+    CHECK(mps_weight(1.5 * re, re) == 0.0);
+    CHECK_NEAR(mps_weight(0.5 * re, re), 1.0, 1e-15);
+}
+
+int main(void)
+{
+    test_random();
+    test_lattice(1.0, 0.0);
+    test_lattice(0.01, -0.35);
+    test_errors();
+    test_kernel();
+    return test_summary("test_nbr");
+}
