@@ -1,0 +1,114 @@
+/* The semi-implicit MPS fluid (paper 4.1, 4.3): state and one time step.
+ * Particles are stored as a structure of arrays in three segments:
+ *   [0, nfluid)            fluid
+ *   [nfluid, nfixed_end)   tank wall (first layer, in the PPE) and dummy layers
+ *   [nfixed_end, n)        solid particles given by a coupled solid (moving
+ *                          boundary): surface ones in the PPE, inner ones only
+ *                          in the number density. */
+#ifndef FLUID_H
+#define FLUID_H
+
+#include <stddef.h>
+
+#include "fluid_linsolve.h"
+#include "fluid_params.h"
+#include "mps_dim.h"
+#include "mps_json.h"
+#include "mps_nbr.h"
+#include "mps_particles.h"
+#include "mps_timer.h"
+
+enum fluid_ptype { FLUID_P = 0, WALL_P = 1, DUMMY_P = 2, SOLID_SURF_P = 3, SOLID_INNER_P = 4 };
+
+enum fluid_phase {
+    PH_NBR, PH_PREDICT, PH_DENSITY, PH_ASSEMBLE, PH_SOLVE, PH_CORRECT, PH_OTHER, PH_COUNT
+};
+
+struct fluid {
+    struct fluid_params prm;
+    struct mps_particles ps;
+    /* fields (registered in ps) */
+    double (*x)[MPS_DIM];
+    double (*v)[MPS_DIM];
+    double (*vstar)[MPS_DIM];
+    double (*lap)[MPS_DIM];
+    double (*grad)[MPS_DIM];
+    double *p;
+    double *div;           /* divergence of v* (mixed PPE source) */
+    double *nd;            /* particle number density n* (re_n) */
+    int *ncount;           /* neighbours within re_n */
+    int *type;             /* enum fluid_ptype */
+    int *id;               /* stable id (solid particles: the solid's id) */
+    int *row;              /* PPE row, -1 if not an unknown */
+    unsigned char *surface; /* free surface (P = 0) */
+    unsigned char *has_p;   /* carries a pressure: fluid, wall, solid surface */
+    unsigned char *is_fluid;
+    unsigned char *fallback; /* corrected gradient fell back to Eq. 9 */
+    size_t nfluid, nfixed_end;
+    /* lattice constants */
+    double n0, n0_lap, lambda_lap;
+    double load_scale;     /* Eq. 50 normalisation, see fluid_coupling.c */
+    int solid_placed;      /* walls under the solid removed */
+    int count0;
+    /* neighbours */
+    struct mps_nbr_grid grid;
+    struct mps_nbr_list nl;       /* re_lap + skin, built at x^n */
+    struct mps_nbr_list nl_n;     /* re_n, filtered from nl at x* */
+    double *wlap;                 /* Laplacian weight of each nl pair at x* (PPE) */
+    size_t cap_wlap;
+    double skin;
+    /* PPE */
+    int nrows;
+    int *rowptr, *col;
+    double *val, *rhs, *sol;
+    size_t cap_rows, cap_nnz;
+    struct fluid_linsolve *ls;
+    /* bookkeeping */
+    double time;
+    long step;
+    double dt_last;
+    long ppe_iterations;
+    long nbr_rebuilds;
+    struct mps_timer timer;
+};
+
+/* Builds the tank and the water blocks from validated parameters. */
+enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
+                             struct mps_err *err);
+void fluid_destroy(struct fluid **f);
+
+/* The step the CFL condition (Eq. 52) allows now, capped by dt_max. */
+double fluid_cfl_dt(const struct fluid *f);
+
+/* One step of dt (Eq. 16-24). Fails with MPS_EDIVERGED on NaN or a particle
+ * leaving the domain, MPS_ESOLVE if the PPE solve fails. */
+enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err);
+
+/* Replaces the solid particles (coupled runs). surface[k] selects PPE
+ * particles; the rest only count in the number density. On the first call,
+ * wall and dummy particles closer than dp/2 to a solid particle are removed,
+ * so a solid clamped into the tank floor replaces the wall there. */
+enum mps_status fluid_set_solid(struct fluid *f, size_t n, const int *id,
+                                const double (*x)[MPS_DIM], const double (*v)[MPS_DIM],
+                                const unsigned char *surface, struct mps_err *err);
+
+/* Loads on the solid surface particles after a step: pressure and the fluid
+ * force of Eq. 50-51 times the particle volume dp^d (N per metre in 2D).
+ * Fills up to max entries in the order of the solid particles given to
+ * fluid_set_solid (surface ones only); returns the count. */
+size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
+                         double (*force)[MPS_DIM], size_t max);
+
+/* Recomputes the type masks (has_p, is_fluid) after particle types change. */
+void fluid_update_masks(struct fluid *f);
+
+/* Current value of probe k (see enum fluid_probe_kind). */
+double fluid_probe(const struct fluid *f, int k);
+
+/* Output fields for a snapshot; returns the count written into out. */
+int fluid_output_fields(const struct fluid *f, struct mps_field *out, int max);
+
+/* Summary members (counts, phase times) into an open JSON object. */
+void fluid_summary(const struct fluid *f, struct mps_json *j);
+
+#endif

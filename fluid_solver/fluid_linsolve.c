@@ -1,0 +1,875 @@
+/* Sparse SPD solves for the PPE: PCG (Jacobi or IC(0)) and CHOLMOD.
+ * See fluid_linsolve.h for the contract and docs/ppe_solvers.md for the
+ * measurements behind "auto". */
+#include "fluid_linsolve.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cholmod.h>
+
+enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE };
+
+static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse"};
+
+/* "auto": warm-started PCG with the IC(0) preconditioner. On the synthetic
+ * PPE (jittered lattice, ~48 nnz/row, rtol 1e-8, 2 cores, min of 3 runs, see
+ * docs/ppe_solvers.md) warm-started pcg_ic0 took 4 / 19 / 104 ms at
+ * n = 5k / 20k / 80k against 5 / 22 / 125 ms for pcg_jacobi and
+ * 29 / 140 / 780 ms for cholmod_reuse, with ~3x fewer iterations than Jacobi
+ * (so fewer chances to stall on a harder real matrix). */
+#define AUTO_METHOD M_PCG_IC0
+
+#define METHOD_LIST "pcg_jacobi, pcg_ic0, cholmod, cholmod_reuse, auto"
+
+/* Below this many rows a parallel region costs more than it saves. */
+#define PAR_MIN_ROWS 4096
+/* Per-thread partial sums, padded to a cache line so threads do not share one. */
+#define PAD 8
+
+struct fluid_linsolve {
+    enum method method;
+    double rtol;
+    int max_iter;
+    int nthreads;        /* resolved: > 0 */
+
+    /* PCG work vectors, capacity cap_n */
+    size_t cap_n;
+    double *r, *z, *p, *q, *dinv;
+    int *diag;           /* position of the diagonal in each row of A */
+    double *partial;     /* nthreads * PAD reduction slots */
+
+    /* IC(0) factor: lower triangle of A in CSR (diagonal last in each row),
+     * overwritten by L; the diagonal is kept inverted in linv. */
+    size_t cap_lnz;
+    int *lptr, *lcol, *mark;
+    double *lval, *linv;
+
+    /* CHOLMOD */
+    int cm_started;
+    cholmod_common cm;
+    cholmod_factor *L;
+    cholmod_dense *X, *Y, *E;   /* cholmod_solve2 workspace, reused */
+    /* cholmod_reuse: ordering and pattern of the last analysis */
+    int *perm;
+    int perm_n;                 /* rows perm is for; -1 = none */
+    int *pat_ptr, *pat_col;     /* copy of the pattern the symbolic factor L was built for */
+    size_t cap_perm, cap_pat;
+    double flops_ref;    /* factorisation flops / nnz(A) of the last fresh ordering */
+};
+
+/* ---- CHOLMOD error capture: the handler has no user pointer, so the last
+ * message goes into a thread-local buffer that the caller copies into err. */
+static _Thread_local char cholmod_msg[256];
+
+static void cholmod_error_capture(int status, const char *file, int line, const char *message)
+{
+    (void)file;
+    (void)line;
+    snprintf(cholmod_msg, sizeof cholmod_msg, "%s (status %d)", message ? message : "?", status);
+}
+
+static const char *cholmod_status_text(int status)
+{
+    switch (status) {
+    case CHOLMOD_OK: return "ok";
+    case CHOLMOD_NOT_INSTALLED: return "method not installed";
+    case CHOLMOD_OUT_OF_MEMORY: return "out of memory";
+    case CHOLMOD_TOO_LARGE: return "integer overflow";
+    case CHOLMOD_INVALID: return "invalid input";
+    case CHOLMOD_NOT_POSDEF: return "matrix not positive definite";
+    case CHOLMOD_DSMALL: return "tiny diagonal in the factor";
+    default: return "unknown status";
+    }
+}
+
+/* A failed CHOLMOD call: MPS_ENOMEM for memory, MPS_ESOLVE when the matrix
+ * is not positive definite, MPS_ELIB otherwise. */
+static enum mps_status cholmod_fail(struct fluid_linsolve *s, const char *call,
+                                    struct mps_err *err)
+{
+    int st = s->cm.status;
+    enum mps_status code = st == CHOLMOD_OUT_OF_MEMORY ? MPS_ENOMEM
+                         : st == CHOLMOD_NOT_POSDEF  ? MPS_ESOLVE
+                                                     : MPS_ELIB;
+    return mps_err_set(err, code, "%s: %s failed: %s%s%s", method_names[s->method], call,
+                       cholmod_status_text(st), cholmod_msg[0] ? ": " : "", cholmod_msg);
+}
+
+/* ---------------------------------------------------------------------- */
+
+const char *fluid_linsolve_methods(void) { return METHOD_LIST; }
+
+const char *fluid_linsolve_method(const struct fluid_linsolve *s)
+{
+    return s ? method_names[s->method] : "(none)";
+}
+
+/* realloc that keeps the old block on failure and raises *fail instead, so a
+ * batch of arrays can be grown and checked once. */
+static void *grow(void *p, size_t count, size_t elem, int *fail)
+{
+    void *q = realloc(p, (count ? count : 1) * elem);
+    if (!q)
+        *fail = 1;
+    return q ? q : p;
+}
+
+static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struct mps_err *err)
+{
+    if (n <= s->cap_n)
+        return MPS_OK;
+    size_t c = n + n / 8;   /* particles come and go: a little slack avoids churn */
+    int fail = 0;
+    s->r = grow(s->r, c, sizeof *s->r, &fail);
+    s->z = grow(s->z, c, sizeof *s->z, &fail);
+    s->p = grow(s->p, c, sizeof *s->p, &fail);
+    s->q = grow(s->q, c, sizeof *s->q, &fail);
+    s->dinv = grow(s->dinv, c, sizeof *s->dinv, &fail);
+    s->diag = grow(s->diag, c, sizeof *s->diag, &fail);
+    if (s->method == M_PCG_IC0) {
+        s->lptr = grow(s->lptr, c + 1, sizeof *s->lptr, &fail);
+        s->mark = grow(s->mark, c, sizeof *s->mark, &fail);
+        s->linv = grow(s->linv, c, sizeof *s->linv, &fail);
+    }
+    if (fail)
+        return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate work vectors for %zu rows",
+                           method_names[s->method], n);
+    s->cap_n = c;
+    return MPS_OK;
+}
+
+enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *method,
+                                      double rtol, int max_iter, int nthreads,
+                                      struct mps_err *err)
+{
+    *out = NULL;
+    enum method m;
+    if (!method)
+        return mps_err_set(err, MPS_EINPUT, "linear solver method not given: expected one of %s",
+                           METHOD_LIST);
+    if (!strcmp(method, "auto")) {
+        m = AUTO_METHOD;
+    } else {
+        int found = -1;
+        for (int i = 0; i < (int)(sizeof method_names / sizeof *method_names); i++)
+            if (!strcmp(method, method_names[i]))
+                found = i;
+        if (found < 0)
+            return mps_err_set(err, MPS_EINPUT,
+                               "unknown linear solver method \"%s\": expected one of %s", method,
+                               METHOD_LIST);
+        m = (enum method)found;
+    }
+    if (!(rtol > 0.0 && rtol < 1.0))
+        return mps_err_set(err, MPS_EINPUT, "linear solver rtol = %g: must be in (0, 1)", rtol);
+    if (max_iter < 1)
+        return mps_err_set(err, MPS_EINPUT, "linear solver max_iter = %d: must be >= 1",
+                           max_iter);
+    if (nthreads < 0)
+        return mps_err_set(err, MPS_EINPUT,
+                           "linear solver nthreads = %d: must be >= 0 (0 = OpenMP default)",
+                           nthreads);
+
+    struct fluid_linsolve *s = calloc(1, sizeof *s);
+    if (!s)
+        return mps_err_set(err, MPS_ENOMEM, "cannot allocate the linear solver");
+    s->method = m;
+    s->rtol = rtol;
+    s->max_iter = max_iter;
+    s->perm_n = -1;
+    s->nthreads = nthreads > 0 ? nthreads : omp_get_max_threads();
+    if (s->nthreads < 1)
+        s->nthreads = 1;
+    s->partial = calloc((size_t)s->nthreads * PAD, sizeof *s->partial);
+    if (!s->partial) {
+        free(s);
+        return mps_err_set(err, MPS_ENOMEM, "cannot allocate the linear solver");
+    }
+    if (m == M_CHOLMOD || m == M_CHOLMOD_REUSE) {
+        cholmod_msg[0] = '\0';
+        if (!cholmod_start(&s->cm)) {
+            fluid_linsolve_destroy(&s);
+            return mps_err_set(err, MPS_ELIB, "%s: cholmod_start failed: %s", method,
+                               cholmod_msg);
+        }
+        s->cm_started = 1;
+        s->cm.print = 0;   /* errors come back through err, not stderr */
+        s->cm.error_handler = cholmod_error_capture;
+    }
+    *out = s;
+    return MPS_OK;
+}
+
+static void free_cholmod_state(struct fluid_linsolve *s)
+{
+    if (!s->cm_started)
+        return;
+    cholmod_free_factor(&s->L, &s->cm);
+    cholmod_free_dense(&s->X, &s->cm);
+    cholmod_free_dense(&s->Y, &s->cm);
+    cholmod_free_dense(&s->E, &s->cm);
+}
+
+void fluid_linsolve_destroy(struct fluid_linsolve **sp)
+{
+    if (!sp || !*sp)
+        return;
+    struct fluid_linsolve *s = *sp;
+    if (s->cm_started) {
+        free_cholmod_state(s);
+        cholmod_finish(&s->cm);
+    }
+    free(s->r);
+    free(s->z);
+    free(s->p);
+    free(s->q);
+    free(s->dinv);
+    free(s->diag);
+    free(s->partial);
+    free(s->lptr);
+    free(s->lcol);
+    free(s->mark);
+    free(s->lval);
+    free(s->linv);
+    free(s->perm);
+    free(s->pat_ptr);
+    free(s->pat_col);
+    free(s);
+    *sp = NULL;
+}
+
+/* ---------------------------------------------------------------------- */
+/* Input checks. Rows are checked in parallel; the first bad row is found with
+ * a min-reduction and then described sequentially, so the message is the
+ * same whatever the thread count. */
+
+static int row_bad(const struct fluid_csr *A, int i, const double *b, const double *x)
+{
+    int lo = A->rowptr[i], hi = A->rowptr[i + 1];
+    if (hi < lo || lo < 0)
+        return 1;
+    int seen_diag = 0, prev = -1;
+    for (int k = lo; k < hi; k++) {
+        int j = A->col[k];
+        if (j <= prev || j >= A->n || !isfinite(A->val[k]))
+            return 1;
+        if (j == i) {
+            seen_diag = 1;
+            if (!(A->val[k] > 0.0))
+                return 1;
+        }
+        prev = j;
+    }
+    return !seen_diag || !isfinite(b[i]) || (x && !isfinite(x[i]));
+}
+
+static enum mps_status describe_bad_row(const struct fluid_linsolve *s, const struct fluid_csr *A,
+                                        int i, const double *b, const double *x,
+                                        struct mps_err *err)
+{
+    const char *mn = method_names[s->method];
+    int lo = A->rowptr[i], hi = A->rowptr[i + 1];
+    if (hi < lo || lo < 0)
+        return mps_err_set(err, MPS_EINPUT, "%s: row %d: rowptr %d..%d is not increasing", mn,
+                           i, lo, hi);
+    int seen_diag = 0, prev = -1;
+    for (int k = lo; k < hi; k++) {
+        int j = A->col[k];
+        if (j >= A->n || j < 0)
+            return mps_err_set(err, MPS_EINPUT, "%s: row %d: column %d out of range [0, %d)",
+                               mn, i, j, A->n);
+        if (j <= prev)
+            return mps_err_set(err, MPS_EINPUT,
+                               "%s: row %d: columns not sorted or repeated (%d after %d)", mn,
+                               i, j, prev);
+        if (!isfinite(A->val[k]))
+            return mps_err_set(err, MPS_ESOLVE, "%s: row %d: A(%d,%d) = %g is not finite", mn,
+                               i, i, j, A->val[k]);
+        if (j == i) {
+            seen_diag = 1;
+            if (!(A->val[k] > 0.0))
+                return mps_err_set(err, MPS_ESOLVE,
+                                   "%s: row %d: diagonal A(%d,%d) = %g: must be > 0 for an "
+                                   "SPD matrix",
+                                   mn, i, i, i, A->val[k]);
+        }
+        prev = j;
+    }
+    if (!seen_diag)
+        return mps_err_set(err, MPS_EINPUT, "%s: row %d: no diagonal entry stored", mn, i);
+    if (!isfinite(b[i]))
+        return mps_err_set(err, MPS_ESOLVE, "%s: row %d: right-hand side b = %g is not finite",
+                           mn, i, b[i]);
+    return mps_err_set(err, MPS_ESOLVE, "%s: row %d: initial guess x = %g is not finite", mn, i,
+                       x ? x[i] : NAN);
+}
+
+static enum mps_status check_input(const struct fluid_linsolve *s, const struct fluid_csr *A,
+                                   const double *b, const double *x, struct mps_err *err)
+{
+    const char *mn = method_names[s->method];
+    if (A->n < 0)
+        return mps_err_set(err, MPS_EINPUT, "%s: matrix size n = %d: must be >= 0", mn, A->n);
+    if (A->n > 0 && (!A->rowptr || !A->col || !A->val || !b))
+        return mps_err_set(err, MPS_EINPUT, "%s: matrix or right-hand side array is NULL", mn);
+    if (A->n > 0 && A->rowptr[0] != 0)
+        return mps_err_set(err, MPS_EINPUT, "%s: rowptr[0] = %d: must be 0", mn, A->rowptr[0]);
+    int n = A->n, bad = n;
+#pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static) \
+    reduction(min : bad)
+    for (int i = 0; i < n; i++)
+        if (i < bad && row_bad(A, i, b, x))
+            bad = i;
+    if (bad < n)
+        return describe_bad_row(s, A, bad, b, x, err);
+    return MPS_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* Vector kernels. Each thread works on one contiguous block of rows (the
+ * same block in every kernel) and leaves its partial sums in s->partial;
+ * they are added in thread order, so results are reproducible for a given
+ * thread count. */
+
+static inline void block(int n, int *lo, int *hi)
+{
+    int t = omp_get_thread_num(), nt = omp_get_num_threads();
+    *lo = (int)((long long)n * t / nt);
+    *hi = (int)((long long)n * (t + 1) / nt);
+}
+
+static inline double row_dot(const struct fluid_csr *A, int i, const double *v)
+{
+    double acc = 0.0;
+    for (int k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+        acc += A->val[k] * v[A->col[k]];
+    return acc;
+}
+
+/* Sums slot `which` of the nused threads' partials. */
+static double gather(const struct fluid_linsolve *s, int nused, int which)
+{
+    double sum = 0.0;
+    for (int t = 0; t < nused; t++)
+        sum += s->partial[t * PAD + which];
+    return sum;
+}
+
+/* r = b - A x; returns r.r and b.b in out[0], out[1]. nt: threads to use. */
+static void k_residual(struct fluid_linsolve *s, int nt, const struct fluid_csr *A,
+                       const double *b, const double *x, double *r, double out[2])
+{
+    int n = A->n, nused = 1;
+#pragma omp parallel num_threads(nt) if (n >= PAR_MIN_ROWS)
+    {
+        int lo, hi;
+        block(n, &lo, &hi);
+        double rr = 0.0, bb = 0.0;
+        for (int i = lo; i < hi; i++) {
+            double ri = b[i] - row_dot(A, i, x);
+            r[i] = ri;
+            rr += ri * ri;
+            bb += b[i] * b[i];
+        }
+        int t = omp_get_thread_num();
+        s->partial[t * PAD] = rr;
+        s->partial[t * PAD + 1] = bb;
+        if (t == 0)
+            nused = omp_get_num_threads();
+    }
+    out[0] = gather(s, nused, 0);
+    out[1] = gather(s, nused, 1);
+}
+
+/* q = A p; returns p.q */
+static double k_spmv_dot(struct fluid_linsolve *s, const struct fluid_csr *A, const double *p,
+                         double *q)
+{
+    int n = A->n, nused = 1;
+#pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
+    {
+        int lo, hi;
+        block(n, &lo, &hi);
+        double pq = 0.0;
+        for (int i = lo; i < hi; i++) {
+            double qi = row_dot(A, i, p);
+            q[i] = qi;
+            pq += p[i] * qi;
+        }
+        int t = omp_get_thread_num();
+        s->partial[t * PAD] = pq;
+        if (t == 0)
+            nused = omp_get_num_threads();
+    }
+    return gather(s, nused, 0);
+}
+
+/* x += a p; r -= a q; returns r.r. With dinv (Jacobi) also z = dinv r and
+ * r.z in out[1]. */
+static void k_update(struct fluid_linsolve *s, int n, double a, const double *p, const double *q,
+                     double *x, double *r, const double *dinv, double *z, double out[2])
+{
+    int nused = 1;
+#pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
+    {
+        int lo, hi;
+        block(n, &lo, &hi);
+        double rr = 0.0, rz = 0.0;
+        if (dinv) {
+            for (int i = lo; i < hi; i++) {
+                x[i] += a * p[i];
+                double ri = r[i] - a * q[i];
+                double zi = dinv[i] * ri;
+                r[i] = ri;
+                z[i] = zi;
+                rr += ri * ri;
+                rz += ri * zi;
+            }
+        } else {
+            for (int i = lo; i < hi; i++) {
+                x[i] += a * p[i];
+                double ri = r[i] - a * q[i];
+                r[i] = ri;
+                rr += ri * ri;
+            }
+        }
+        int t = omp_get_thread_num();
+        s->partial[t * PAD] = rr;
+        s->partial[t * PAD + 1] = rz;
+        if (t == 0)
+            nused = omp_get_num_threads();
+    }
+    out[0] = gather(s, nused, 0);
+    out[1] = gather(s, nused, 1);
+}
+
+/* z = dinv r; returns r.z */
+static double k_jacobi(struct fluid_linsolve *s, int n, const double *r, double *z)
+{
+    int nused = 1;
+    const double *dinv = s->dinv;
+#pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
+    {
+        int lo, hi;
+        block(n, &lo, &hi);
+        double rz = 0.0;
+        for (int i = lo; i < hi; i++) {
+            z[i] = dinv[i] * r[i];
+            rz += r[i] * z[i];
+        }
+        int t = omp_get_thread_num();
+        s->partial[t * PAD] = rz;
+        if (t == 0)
+            nused = omp_get_num_threads();
+    }
+    return gather(s, nused, 0);
+}
+
+/* p = z + beta p */
+static void k_direction(struct fluid_linsolve *s, int n, double beta, const double *z, double *p)
+{
+#pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
+    {
+        int lo, hi;
+        block(n, &lo, &hi);
+        for (int i = lo; i < hi; i++)
+            p[i] = z[i] + beta * p[i];
+    }
+}
+
+/* ---------------------------------------------------------------------- */
+/* IC(0): L L^T ~= A with L restricted to the lower-triangle pattern of A
+ * (Meijerink & van der Vorst 1977; it exists for M-matrices). Row-oriented:
+ * L_ik = (a_ik - sum_{j<k} L_ij L_kj) / L_kk over the common pattern. The
+ * common pattern is found without a branch: mark[j] is the position of L_ij
+ * for the columns of row i and otherwise a sentinel position holding 0.
+ * Returns -1 on success or the row whose pivot was not positive. */
+static int ic0_factor(struct fluid_linsolve *s, const struct fluid_csr *A, double shift)
+{
+    int n = A->n;
+    int *lptr = s->lptr, *lcol = s->lcol, *mark = s->mark;
+    double *lval = s->lval, *linv = s->linv;
+    /* Copy the lower triangle (diagonal is the last entry of each row). */
+    int nz = 0;
+    lptr[0] = 0;
+    for (int i = 0; i < n; i++) {
+        int end = s->diag[i];
+        for (int k = A->rowptr[i]; k <= end; k++) {
+            lcol[nz] = A->col[k];
+            lval[nz] = A->val[k];
+            nz++;
+        }
+        lval[nz - 1] *= 1.0 + shift;
+        lptr[i + 1] = nz;
+    }
+    const int zero = nz;
+    lval[zero] = 0.0;
+    for (int i = 0; i < n; i++)
+        mark[i] = zero;
+    for (int i = 0; i < n; i++) {
+        int lo = lptr[i], dpos = lptr[i + 1] - 1;
+        for (int p = lo; p < dpos; p++)
+            mark[lcol[p]] = p;
+        double dsum = 0.0;
+        for (int p = lo; p < dpos; p++) {
+            int k = lcol[p];
+            double v = lval[p];
+            int kend = lptr[k + 1] - 1;
+            for (int q = lptr[k]; q < kend; q++)
+                v -= lval[mark[lcol[q]]] * lval[q];
+            v *= linv[k];
+            lval[p] = v;
+            dsum += v * v;
+        }
+        for (int p = lo; p < dpos; p++)
+            mark[lcol[p]] = zero;
+        double d = lval[dpos] - dsum;
+        /* A pivot that lost all but 1e-14 of the diagonal is as bad as a negative one. */
+        if (!(d > 1e-14 * lval[dpos]))
+            return i;
+        lval[dpos] = sqrt(d);
+        linv[i] = 1.0 / lval[dpos];
+    }
+    return -1;
+}
+
+static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_csr *A,
+                                 struct mps_err *err)
+{
+    int n = A->n;
+    size_t lnz = 0;
+    for (int i = 0; i < n; i++)
+        lnz += (size_t)(s->diag[i] - A->rowptr[i] + 1);
+    lnz++;   /* the zero sentinel of ic0_factor */
+    if (lnz > s->cap_lnz) {
+        size_t c = lnz + lnz / 8;
+        int fail = 0;
+        s->lcol = grow(s->lcol, c, sizeof *s->lcol, &fail);
+        s->lval = grow(s->lval, c, sizeof *s->lval, &fail);
+        if (fail)
+            return mps_err_set(err, MPS_ENOMEM, "pcg_ic0: cannot allocate the IC(0) factor "
+                                                "(%zu entries)", lnz);
+        s->cap_lnz = c;
+    }
+    /* Shifted IC (Manteuffel 1980) as the fallback: scale the diagonal by
+     * 1 + shift, shift = 1e-3, 1e-2, ..., until every pivot is positive. */
+    double shift = 0.0;
+    int row;
+    while ((row = ic0_factor(s, A, shift)) >= 0) {
+        if (shift >= 10.0)
+            return mps_err_set(err, MPS_ESOLVE,
+                               "pcg_ic0: incomplete Cholesky breaks down at row %d even with "
+                               "the diagonal scaled by 1 + %g: matrix is not positive definite",
+                               row, shift);
+        shift = shift > 0.0 ? 10.0 * shift : 1e-3;
+    }
+    return MPS_OK;
+}
+
+/* z = (L L^T)^{-1} r; returns r.z. Sequential: each row needs the previous. */
+static double ic0_apply(const struct fluid_linsolve *s, int n, const double *r, double *z)
+{
+    const int *lptr = s->lptr, *lcol = s->lcol;
+    const double *lval = s->lval, *linv = s->linv;
+    for (int i = 0; i < n; i++) {   /* L y = r */
+        double v = r[i];
+        int dpos = lptr[i + 1] - 1;
+        for (int p = lptr[i]; p < dpos; p++)
+            v -= lval[p] * z[lcol[p]];
+        z[i] = v * linv[i];
+    }
+    double rz = 0.0;
+    for (int i = n - 1; i >= 0; i--) {   /* L^T z = y, column by column */
+        double zi = z[i] * linv[i];
+        z[i] = zi;
+        rz += r[i] * zi;
+        int dpos = lptr[i + 1] - 1;
+        for (int p = lptr[i]; p < dpos; p++)
+            z[lcol[p]] -= lval[p] * zi;
+    }
+    return rz;
+}
+
+/* ---------------------------------------------------------------------- */
+
+static double precond(struct fluid_linsolve *s, int n, const double *r, double *z)
+{
+    return s->method == M_PCG_IC0 ? ic0_apply(s, n, r, z) : k_jacobi(s, n, r, z);
+}
+
+static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, const double *b,
+                           double *x, struct fluid_linsolve_stats *st, struct mps_err *err)
+{
+    int n = A->n;
+    const char *mn = method_names[s->method];
+    enum mps_status rc = reserve_vectors(s, (size_t)n, err);
+    if (rc)
+        return rc;
+
+    double *r = s->r, *z = s->z, *p = s->p, *q = s->q;
+    const double *dinv = s->method == M_PCG_JACOBI ? s->dinv : NULL;
+    double t0 = omp_get_wtime(), rb[2];
+    k_residual(s, s->nthreads, A, b, x, r, rb);
+    double bnorm = sqrt(rb[1]);
+    if (bnorm == 0.0) {   /* b = 0: x = 0 exactly, no iteration */
+        memset(x, 0, (size_t)n * sizeof *x);
+        st->residual = 0.0;
+        st->t_solve = omp_get_wtime() - t0;
+        return MPS_OK;
+    }
+    double tol2 = s->rtol * bnorm * s->rtol * bnorm;
+    if (rb[0] <= tol2) {   /* the warm start is already good enough: no set-up either */
+        st->residual = sqrt(rb[0]) / bnorm;
+        st->t_solve = omp_get_wtime() - t0;
+        return MPS_OK;
+    }
+
+    double t1 = omp_get_wtime();
+#pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static)
+    for (int i = 0; i < n; i++) {
+        int k = A->rowptr[i];
+        while (A->col[k] != i)   /* check_input guarantees it is there */
+            k++;
+        s->diag[i] = k;
+        s->dinv[i] = 1.0 / A->val[k];
+    }
+    if (s->method == M_PCG_IC0 && (rc = ic0_setup(s, A, err)))
+        return rc;
+    double t2 = omp_get_wtime();
+    st->t_factor = t2 - t1;
+
+    double rr = rb[0];
+    int it = 0, converged = 0;
+    double rz = precond(s, n, r, z);
+    memcpy(p, z, (size_t)n * sizeof *p);
+    while (it < s->max_iter) {
+        double pq = k_spmv_dot(s, A, p, q);
+        it++;
+        if (!(pq > 0.0) || !(rz > 0.0)) {
+            st->iterations = it;
+            st->residual = sqrt(rr) / bnorm;
+            st->t_solve = (t1 - t0) + (omp_get_wtime() - t2);
+            return mps_err_set(err, MPS_ESOLVE,
+                               "%s: matrix or preconditioner not positive definite "
+                               "(p.Ap = %g, r.z = %g at iteration %d)",
+                               mn, pq, rz, it);
+        }
+        double alpha = rz / pq, upd[2];
+        k_update(s, n, alpha, p, q, x, r, dinv, z, upd);
+        rr = upd[0];
+        if (rr <= tol2) {
+            /* The recursive residual drifts from b - Ax in finite precision:
+             * accept only if the true one agrees, else restart from it. */
+            k_residual(s, s->nthreads, A, b, x, r, rb);
+            rr = rb[0];
+            if (rr <= tol2) {
+                converged = 1;
+                break;
+            }
+            rz = precond(s, n, r, z);
+            memcpy(p, z, (size_t)n * sizeof *p);
+            continue;
+        }
+        double rz_new = dinv ? upd[1] : ic0_apply(s, n, r, z);
+        double beta = rz_new / rz;
+        rz = rz_new;
+        k_direction(s, n, beta, z, p);
+    }
+    st->iterations = it;
+    st->residual = sqrt(rr) / bnorm;
+    st->t_solve = (t1 - t0) + (omp_get_wtime() - t2);
+    if (!converged)
+        return mps_err_set(err, MPS_ESOLVE,
+                           "%s: PCG did not converge in %d iterations (residual %.3g > rtol %.3g)",
+                           mn, it, st->residual, s->rtol);
+    return MPS_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+/* CHOLMOD. The CSR arrays are viewed, not copied, as a CSC matrix: for a
+ * symmetric matrix row i of the CSR is column i of the CSC. stype = 1 tells
+ * CHOLMOD to read the upper triangle only. CHOLMOD does not write to A. */
+
+static int same_pattern(const struct fluid_linsolve *s, const struct fluid_csr *A)
+{
+    size_t nnz = (size_t)A->rowptr[A->n];
+    return s->L && s->perm_n == A->n && (size_t)s->pat_ptr[A->n] == nnz &&
+           !memcmp(s->pat_ptr, A->rowptr, (size_t)(A->n + 1) * sizeof *A->rowptr) &&
+           !memcmp(s->pat_col, A->col, nnz * sizeof *A->col);
+}
+
+/* cholmod_reuse bookkeeping after an analysis: remember the ordering and the
+ * pattern. Failing to allocate only turns reuse off for the next call. */
+static void remember_analysis(struct fluid_linsolve *s, const struct fluid_csr *A)
+{
+    size_t n = (size_t)A->n, nnz = (size_t)A->rowptr[n];
+    int fail = 0;
+    s->perm_n = -1;
+    if (n + 1 > s->cap_perm) {
+        s->perm = grow(s->perm, n + n / 8 + 1, sizeof *s->perm, &fail);
+        s->pat_ptr = grow(s->pat_ptr, n + n / 8 + 1, sizeof *s->pat_ptr, &fail);
+        if (fail)
+            return;
+        s->cap_perm = n + n / 8 + 1;
+    }
+    if (nnz > s->cap_pat) {
+        s->pat_col = grow(s->pat_col, nnz + nnz / 8, sizeof *s->pat_col, &fail);
+        if (fail)
+            return;
+        s->cap_pat = nnz + nnz / 8;
+    }
+    memcpy(s->perm, s->L->Perm, n * sizeof *s->perm);
+    memcpy(s->pat_ptr, A->rowptr, (n + 1) * sizeof *s->pat_ptr);
+    memcpy(s->pat_col, A->col, nnz * sizeof *s->pat_col);
+    s->perm_n = (int)n;
+}
+
+/* Symbolic analysis of A into s->L. cholmod_reuse first tries the ordering
+ * of the previous matrix of the same size and keeps it only if the predicted
+ * factorisation flops (per nonzero of A) are within 10% of what the last
+ * fresh ordering gave. Measured on the synthetic PPE: after a motion of 0.02
+ * particle spacings the old ordering had 1.8x the fill and 4.5x the flops
+ * (new edges cross its separators), while a fresh ordering costs only about
+ * a quarter of a factorisation. */
+static enum mps_status analyse(struct fluid_linsolve *s, cholmod_sparse *As,
+                               const struct fluid_csr *A, struct mps_err *err)
+{
+    cholmod_common *cm = &s->cm;
+    double nnz = (double)A->rowptr[A->n];
+    int reuse = s->method == M_CHOLMOD_REUSE;
+    cholmod_free_factor(&s->L, cm);
+    if (reuse && s->perm_n == A->n) {
+        cm->nmethods = 1;
+        cm->method[0].ordering = CHOLMOD_GIVEN;
+        cm->postorder = 1;
+        s->L = cholmod_analyze_p(As, s->perm, NULL, 0, cm);
+        cm->nmethods = 0;   /* back to CHOLMOD's default ordering strategy */
+        if (!s->L || cm->status < CHOLMOD_OK) {
+            s->perm_n = -1;
+            cholmod_free_factor(&s->L, cm);
+            return cholmod_fail(s, "cholmod_analyze_p", err);
+        }
+        if (cm->fl <= 1.1 * s->flops_ref * nnz) {
+            remember_analysis(s, A);
+            return MPS_OK;
+        }
+        cholmod_free_factor(&s->L, cm);
+    }
+    s->L = cholmod_analyze(As, cm);
+    if (!s->L || cm->status < CHOLMOD_OK) {
+        s->perm_n = -1;
+        cholmod_free_factor(&s->L, cm);
+        return cholmod_fail(s, "cholmod_analyze", err);
+    }
+    if (reuse) {
+        s->flops_ref = cm->fl / nnz;
+        remember_analysis(s, A);
+    }
+    return MPS_OK;
+}
+
+static enum mps_status direct(struct fluid_linsolve *s, const struct fluid_csr *A,
+                              const double *b, double *x, struct fluid_linsolve_stats *st,
+                              struct mps_err *err)
+{
+    int n = A->n;
+    size_t nnz = (size_t)A->rowptr[n];
+    cholmod_common *cm = &s->cm;
+    cholmod_sparse As = {0};   /* a view of A, see above */
+    As.nrow = As.ncol = (size_t)n;
+    As.nzmax = nnz;
+    As.p = (void *)A->rowptr;
+    As.i = (void *)A->col;
+    As.x = (void *)A->val;
+    As.stype = 1;
+    As.itype = CHOLMOD_INT;
+    As.xtype = CHOLMOD_REAL;
+    As.dtype = CHOLMOD_DOUBLE;
+    As.sorted = 1;
+    As.packed = 1;
+    cholmod_msg[0] = '\0';
+    enum mps_status rc = reserve_vectors(s, (size_t)n, err);   /* residual vector */
+    if (rc)
+        return rc;
+
+    double t0 = omp_get_wtime();
+    int reuse = s->method == M_CHOLMOD_REUSE;
+    if (!(reuse && same_pattern(s, A))) {   /* else the symbolic factor is still valid */
+        if ((rc = analyse(s, &As, A, err)))
+            return rc;
+        st->t_analyse = omp_get_wtime() - t0;
+    }
+    double t1 = omp_get_wtime();
+
+    /* Positive status values are warnings; only "not positive definite" matters. */
+    if (!cholmod_factorize(&As, s->L, cm) || cm->status < CHOLMOD_OK ||
+        cm->status == CHOLMOD_NOT_POSDEF) {
+        if (cm->status == CHOLMOD_NOT_POSDEF)
+            rc = mps_err_set(err, MPS_ESOLVE,
+                             "%s: cholmod_factorize: matrix not positive definite (pivot %zu of "
+                             "%d, in the fill-reducing ordering, is not positive)",
+                             method_names[s->method], (size_t)s->L->minor + 1, n);
+        else
+            rc = cholmod_fail(s, "cholmod_factorize", err);
+        cholmod_free_factor(&s->L, cm);
+        s->perm_n = -1;   /* start over next call */
+        return rc;
+    }
+    double t2 = omp_get_wtime();
+    st->t_factor = t2 - t1;
+
+    cholmod_dense B = {0};
+    B.nrow = (size_t)n;
+    B.ncol = 1;
+    B.nzmax = (size_t)n;
+    B.d = (size_t)n;
+    B.xtype = CHOLMOD_REAL;
+    B.dtype = CHOLMOD_DOUBLE;
+    B.x = (void *)b;
+    double rb[2];
+    /* One or two steps of iterative refinement if the factor was not quite
+     * accurate enough for rtol (never needed on well-scaled PPEs). */
+    for (int pass = 0; pass < 3; pass++) {
+        if (!cholmod_solve2(CHOLMOD_A, s->L, &B, NULL, &s->X, NULL, &s->Y, &s->E, cm) ||
+            cm->status < CHOLMOD_OK)
+            return cholmod_fail(s, "cholmod_solve2", err);
+        const double *xs = s->X->x;
+        if (pass == 0)
+            memcpy(x, xs, (size_t)n * sizeof *x);
+        else
+            for (int i = 0; i < n; i++)
+                x[i] += xs[i];
+        /* Sequential on purpose: OpenBLAS (pthreads build) keeps its workers
+         * spinning after a call, and an OpenMP team started now fights them
+         * for the cores (measured: the next parallel solve ran 20x slower). */
+        k_residual(s, 1, A, b, x, s->r, rb);
+        if (rb[0] <= s->rtol * s->rtol * rb[1])
+            break;
+        B.x = s->r;
+    }
+    st->residual = rb[1] > 0.0 ? sqrt(rb[0] / rb[1]) : 0.0;
+    st->t_solve = omp_get_wtime() - t2;
+    return MPS_OK;
+}
+
+/* ---------------------------------------------------------------------- */
+
+enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct fluid_csr *A,
+                                     const double *b, double *x,
+                                     struct fluid_linsolve_stats *stats, struct mps_err *err)
+{
+    struct fluid_linsolve_stats local;
+    struct fluid_linsolve_stats *st = stats ? stats : &local;
+    memset(st, 0, sizeof *st);
+    if (!s || !A || (A->n > 0 && !x))
+        return mps_err_set(err, MPS_EINPUT, "fluid_linsolve_solve: NULL solver, matrix or x");
+    int iterative = s->method == M_PCG_JACOBI || s->method == M_PCG_IC0;
+    enum mps_status rc = check_input(s, A, b, iterative ? x : NULL, err);
+    if (rc || A->n == 0)
+        return rc;
+    return iterative ? pcg(s, A, b, x, st, err) : direct(s, A, b, x, st, err);
+}

@@ -1,0 +1,184 @@
+#include "fluid_params.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define NOHI (MPS_KEY_NO_HI)
+#define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
+
+const struct mps_key_spec fluid_case_keys[] = {
+    {"fluid.rho", MPS_KEY_DOUBLE, "1000", 0, 0, POS, NULL, "kg/m^3", "water density"},
+    {"fluid.nu", MPS_KEY_DOUBLE, "1e-6", 0, 0, NOHI, NULL, "m^2/s", "kinematic viscosity"},
+    {"fluid.courant", MPS_KEY_DOUBLE, "0.2", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "Courant number C of Eq. 52"},
+    {"fluid.dt_max", MPS_KEY_DOUBLE, "1e-3", 0, 0, POS, NULL, "s", "cap on the fluid step"},
+    {"fluid.dt_min", MPS_KEY_DOUBLE, "1e-7", 0, 0, POS, NULL, "s",
+     "smallest step the CFL condition may ask for before the run is declared diverged"},
+    {"fluid.kappa", MPS_KEY_DOUBLE, "0.01", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "relaxation of the PPE source term (Eq. 23)"},
+    {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
+     "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
+     "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
+    {"fluid.alpha", MPS_KEY_DOUBLE, "1e-7", 0, 0, NOHI, NULL, "1/Pa",
+     "compressibility 1/(rho c^2) of the weakly compressible PPE (Eq. 21-23)"},
+    {"fluid.re_n", MPS_KEY_DOUBLE, "2.1", 1, 0, POS, NULL, "dp",
+     "effective radius for number density and gradient"},
+    {"fluid.re_lap", MPS_KEY_DOUBLE, "4.0", 1, 0, POS, NULL, "dp",
+     "effective radius for the Laplacian"},
+    {"fluid.beta1", MPS_KEY_DOUBLE, "0.97", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "free surface if n < beta1 n0 ..."},
+    {"fluid.beta2", MPS_KEY_DOUBLE, "0.85", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "... and neighbour count < beta2 N0"},
+    {"fluid.gradient", MPS_KEY_ENUM, "corrected", 0, 0, 0, "corrected|plain", "",
+     "pressure gradient: Eq. 14-15 (corrected) or Eq. 9 (plain)"},
+    {"fluid.gradient_min", MPS_KEY_BOOL, "true", 0, 0, 0, NULL, "",
+     "subtract the neighbourhood minimum pressure (repulsive pair terms only)"},
+    {"fluid.clamp_negative", MPS_KEY_BOOL, "true", 0, 0, 0, NULL, "",
+     "set negative PPE pressures to zero"},
+    {"fluid.collision_distance", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
+     "fluid particles closer than this are pushed apart (0: off)"},
+    {"fluid.collision_restitution", MPS_KEY_DOUBLE, "0.2", 0, 1, 0, NULL, "",
+     "restitution of that collision"},
+    {"fluid.ppe_solver", MPS_KEY_ENUM, "auto", 0, 0, 0,
+     "auto|pcg_jacobi|pcg_ic0|cholmod|cholmod_reuse", "", "linear solver for the PPE"},
+    {"fluid.ppe_rtol", MPS_KEY_DOUBLE, "1e-6", 0, 0.1, MPS_KEY_LO_OPEN, NULL, "",
+     "relative residual of iterative PPE solves"},
+    {"fluid.ppe_max_iter", MPS_KEY_INT, "2000", 1, 0, NOHI, NULL, "", "iteration cap"},
+    {"fluid.tank.width", MPS_KEY_DOUBLE, NULL, 0, 0, POS | MPS_KEY_REQUIRED, NULL, "m",
+     "inner width of the tank (left wall inner face at x = 0)"},
+    {"fluid.tank.height", MPS_KEY_DOUBLE, NULL, 0, 0, POS | MPS_KEY_REQUIRED, NULL, "m",
+     "inner height of the side walls (floor at y = 0)"},
+    {"fluid.tank.lid", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "", "close the tank at the top"},
+    {"fluid.tank.wall_layers", MPS_KEY_INT, "3", 3, 8, 0, NULL, "",
+     "wall layer + dummy layers (paper: 3)"},
+    {"fluid.blocks.*.x0", MPS_KEY_DOUBLE, NULL, 0, 0, MPS_KEY_NO_LO | NOHI | MPS_KEY_REQUIRED,
+     NULL, "m", "water block left"},
+    {"fluid.blocks.*.y0", MPS_KEY_DOUBLE, NULL, 0, 0, MPS_KEY_NO_LO | NOHI | MPS_KEY_REQUIRED,
+     NULL, "m", "water block bottom"},
+    {"fluid.blocks.*.x1", MPS_KEY_DOUBLE, NULL, 0, 0, MPS_KEY_NO_LO | NOHI | MPS_KEY_REQUIRED,
+     NULL, "m", "water block right"},
+    {"fluid.blocks.*.y1", MPS_KEY_DOUBLE, NULL, 0, 0, MPS_KEY_NO_LO | NOHI | MPS_KEY_REQUIRED,
+     NULL, "m", "water block top"},
+    {"fluid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
+     "column name in probes.csv"},
+    {"fluid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
+     "front|height|pressure|bottom_pressure|max_speed|escaped", "", "what the probe measures"},
+    {"fluid.probes.*.x", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
+     "probe x (height: column position; pressure: point)"},
+    {"fluid.probes.*.y", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
+     "probe y (pressure: point)"},
+    {NULL, 0, NULL, 0, 0, 0, NULL, NULL, NULL},
+};
+
+static enum fluid_probe_kind probe_kind(const char *s)
+{
+    static const char *const names[] = {"front", "height", "pressure",
+                                        "bottom_pressure", "max_speed", "escaped"};
+    for (int k = 0; k < 6; k++)
+        if (strcmp(s, names[k]) == 0)
+            return (enum fluid_probe_kind)k;
+    return FLUID_PROBE_FRONT; /* unreachable: mps_case validated the enum */
+}
+
+enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case *c,
+                                  struct mps_err *err)
+{
+    memset(p, 0, sizeof *p);
+    p->dp = mps_case_double(c, "dp");
+    p->end_time = mps_case_double(c, "end_time");
+    p->g[0] = mps_case_double(c, "gravity.x");
+    p->g[1] = mps_case_double(c, "gravity.y");
+    p->rho = mps_case_double(c, "fluid.rho");
+    p->nu = mps_case_double(c, "fluid.nu");
+    p->courant = mps_case_double(c, "fluid.courant");
+    p->dt_max = mps_case_double(c, "fluid.dt_max");
+    p->dt_min = mps_case_double(c, "fluid.dt_min");
+    p->kappa = mps_case_double(c, "fluid.kappa");
+    p->alpha = mps_case_double(c, "fluid.alpha");
+    p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
+    p->re_n = mps_case_double(c, "fluid.re_n");
+    p->re_lap = mps_case_double(c, "fluid.re_lap");
+    p->beta1 = mps_case_double(c, "fluid.beta1");
+    p->beta2 = mps_case_double(c, "fluid.beta2");
+    p->gradient = strcmp(mps_case_string(c, "fluid.gradient"), "plain") == 0
+                      ? FLUID_GRAD_PLAIN
+                      : FLUID_GRAD_CORRECTED;
+    p->gradient_min = mps_case_bool(c, "fluid.gradient_min");
+    p->clamp_negative = mps_case_bool(c, "fluid.clamp_negative");
+    p->collision_dist = mps_case_double(c, "fluid.collision_distance");
+    p->collision_restitution = mps_case_double(c, "fluid.collision_restitution");
+    p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");
+    p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");
+    p->ppe_max_iter = (int)mps_case_int(c, "fluid.ppe_max_iter");
+    p->tank_w = mps_case_double(c, "fluid.tank.width");
+    p->tank_h = mps_case_double(c, "fluid.tank.height");
+    p->tank_lid = mps_case_bool(c, "fluid.tank.lid");
+    p->wall_layers = (int)mps_case_int(c, "fluid.tank.wall_layers");
+    p->output_interval = mps_case_double(c, "output.interval");
+    p->probe_interval = mps_case_double(c, "output.probe_interval");
+
+    if (p->re_lap < p->re_n)
+        return mps_case_fail(c, err, "fluid.re_lap", "must be >= fluid.re_n = %g", p->re_n);
+    if (p->dt_max < p->dt_min)
+        return mps_case_fail(c, err, "fluid.dt_max", "must be >= fluid.dt_min = %g", p->dt_min);
+    if (p->tank_w < 4 * p->dp || p->tank_h < 4 * p->dp)
+        return mps_case_fail(c, err, "dp", "too coarse for a tank of %g x %g m", p->tank_w,
+                             p->tank_h);
+
+    p->nblocks = mps_case_count(c, "fluid.blocks");
+    if (p->nblocks > FLUID_MAX_BLOCKS)
+        return mps_case_fail(c, err, "fluid.blocks", "%d blocks: at most %d", p->nblocks,
+                             FLUID_MAX_BLOCKS);
+    double top = 0.0;
+    for (int b = 0; b < p->nblocks; b++) {
+        static const char *const names[4] = {"x0", "y0", "x1", "y1"};
+        char key[64];
+        for (int k = 0; k < 4; k++)
+            p->block[b][k] = mps_case_double(c, "fluid.blocks.%d.%s", b, names[k]);
+        snprintf(key, sizeof key, "fluid.blocks.%d.x1", b);
+        if (p->block[b][2] <= p->block[b][0])
+            return mps_case_fail(c, err, key, "must be > x0 = %g", p->block[b][0]);
+        snprintf(key, sizeof key, "fluid.blocks.%d.y1", b);
+        if (p->block[b][3] <= p->block[b][1])
+            return mps_case_fail(c, err, key, "must be > y0 = %g", p->block[b][1]);
+        /* The block must lie inside the tank (a tolerance of dp/1000 absorbs
+         * decimal round-off in the case file). */
+        const double tol = 1e-3 * p->dp, lim[4] = {0.0, 0.0, p->tank_w, p->tank_h};
+        for (int k = 0; k < 4; k++) {
+            int outside = k < 2 ? p->block[b][k] < lim[k] - tol : p->block[b][k] > lim[k] + tol;
+            if (k == 3 && !p->tank_lid)
+                outside = 0; /* an open tank may hold water above its walls */
+            if (outside) {
+                snprintf(key, sizeof key, "fluid.blocks.%d.%s", b, names[k]);
+                return mps_case_fail(c, err, key,
+                                     "the water block lies outside the tank [0, %g] x [0, %g]",
+                                     p->tank_w, p->tank_h);
+            }
+        }
+        if (p->block[b][3] > top)
+            top = p->block[b][3];
+    }
+
+    /* The CFL cap must be satisfiable: a column of height H reaches about
+     * sqrt(2 g H) on collapse, so the CFL step is C dp / sqrt(2 g H). */
+    double gmag = sqrt(p->g[0] * p->g[0] + p->g[1] * p->g[1]);
+    double vexp = sqrt(2.0 * gmag * top);
+    if (vexp > 0.0 && p->courant * p->dp / vexp < p->dt_min)
+        return mps_case_fail(c, err, "fluid.dt_min",
+                             "the CFL condition (Eq. 52) needs dt <= C dp / v = %.3g s for the "
+                             "expected speed sqrt(2 g H) = %.3g m/s, below dt_min",
+                             p->courant * p->dp / vexp, vexp);
+
+    p->nprobes = mps_case_count(c, "fluid.probes");
+    if (p->nprobes > FLUID_MAX_PROBES)
+        return mps_case_fail(c, err, "fluid.probes", "%d probes: at most %d", p->nprobes,
+                             FLUID_MAX_PROBES);
+    for (int k = 0; k < p->nprobes; k++) {
+        p->probes[k].name = mps_case_string(c, "fluid.probes.%d.name", k);
+        p->probes[k].kind = probe_kind(mps_case_string(c, "fluid.probes.%d.kind", k));
+        p->probes[k].x = mps_case_double(c, "fluid.probes.%d.x", k);
+        p->probes[k].y = mps_case_double(c, "fluid.probes.%d.y", k);
+    }
+    return MPS_OK;
+}

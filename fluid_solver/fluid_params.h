@@ -1,0 +1,62 @@
+/* Fluid case keys (declared once, validated by mps_case) and the resolved
+ * parameters the fluid solver runs with. */
+#ifndef FLUID_PARAMS_H
+#define FLUID_PARAMS_H
+
+#include "mps_case.h"
+#include "mps_dim.h"
+
+#define FLUID_MAX_BLOCKS 16
+#define FLUID_MAX_PROBES 32
+
+enum fluid_gradient { FLUID_GRAD_CORRECTED, FLUID_GRAD_PLAIN };
+
+enum fluid_probe_kind {
+    FLUID_PROBE_FRONT,       /* x of the leading edge of the water on the floor, m */
+    FLUID_PROBE_HEIGHT,      /* water height at x (default: the left wall), m */
+    FLUID_PROBE_PRESSURE,    /* mean pressure of particles within 2 dp of (x, y), Pa */
+    FLUID_PROBE_BOTTOM,      /* mean pressure of the floor's wall particles under water, Pa */
+    FLUID_PROBE_MAX_SPEED,   /* max fluid speed, m/s */
+    FLUID_PROBE_ESCAPED      /* fluid particles outside the tank, count */
+};
+
+struct fluid_probe_def {
+    const char *name;
+    enum fluid_probe_kind kind;
+    double x, y;
+};
+
+struct fluid_params {
+    double dp, end_time, g[MPS_DIM];
+    double rho, nu;
+    double courant, dt_max, dt_min;
+    int mixed_source;             /* add the velocity-divergence source term */
+    double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
+    double re_n, re_lap;          /* effective radii, multiples of dp */
+    double beta1, beta2;          /* free-surface double check */
+    enum fluid_gradient gradient;
+    int gradient_min;             /* subtract the neighbourhood minimum pressure */
+    int clamp_negative;           /* negative PPE pressures set to 0 */
+    double collision_dist;        /* fraction of dp; 0 = off */
+    double collision_restitution;
+    const char *ppe_solver;
+    double ppe_rtol;
+    int ppe_max_iter;
+    double tank_w, tank_h;
+    int tank_lid;
+    int wall_layers;              /* wall + dummy layers, >= 3 */
+    int nblocks;
+    double block[FLUID_MAX_BLOCKS][4]; /* x0, y0, x1, y1 */
+    int nprobes;
+    struct fluid_probe_def probes[FLUID_MAX_PROBES];
+    double output_interval, probe_interval;
+};
+
+extern const struct mps_key_spec fluid_case_keys[];
+
+/* Reads and cross-checks the fluid keys (blocks inside the tank, CFL cap
+ * satisfiable, ...). Errors name file, line and key. */
+enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case *c,
+                                  struct mps_err *err);
+
+#endif

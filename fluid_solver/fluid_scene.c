@@ -1,0 +1,88 @@
+#include "fluid_scene.h"
+
+#include <math.h>
+#include <stdlib.h>
+
+#include "fluid.h"
+
+struct pts_buf {
+    struct fluid_scene_pt *a;
+    size_t n, cap;
+};
+
+static int push(struct pts_buf *b, double x, double y, int type)
+{
+    if (b->n == b->cap) {
+        size_t cap = b->cap ? 2 * b->cap : 1024;
+        void *q = realloc(b->a, cap * sizeof *b->a);
+        if (!q)
+            return -1;
+        b->a = q;
+        b->cap = cap;
+    }
+    b->a[b->n++] = (struct fluid_scene_pt){{x, y}, type};
+    return 0;
+}
+
+/* Number of lattice points with centres at lo + (i + 1/2) dp inside [lo, hi);
+ * a tolerance absorbs decimal round-off (0.584 / 0.004 must give 146). */
+static long lattice_count(double lo, double hi, double dp)
+{
+    double c = (hi - lo) / dp;
+    long k = (long)floor(c + 1e-6);
+    return k < 0 ? 0 : k;
+}
+
+int fluid_scene_build(const struct fluid_params *p, struct fluid_scene_pt **pts, size_t *nfluid,
+                      size_t *nwall)
+{
+    struct pts_buf b = {0};
+    const double dp = p->dp, W = p->tank_w, H = p->tank_h;
+    const int L = p->wall_layers;
+
+    for (int k = 0; k < p->nblocks; k++) {
+        const double *bl = p->block[k];
+        long ni = lattice_count(bl[0], bl[2], dp), nj = lattice_count(bl[1], bl[3], dp);
+        for (long j = 0; j < nj; j++)
+            for (long i = 0; i < ni; i++)
+                if (push(&b, bl[0] + (i + 0.5) * dp, bl[1] + (j + 0.5) * dp, FLUID_P))
+                    goto fail;
+    }
+    size_t nf = b.n;
+
+    /* Side walls run from the bottom of the dummy layers to the top of the
+     * wall (or of the lid's layers); the floor (and lid) span the inner width. */
+    long nx = lattice_count(0.0, W, dp);
+    long ny = lattice_count(0.0, H, dp);
+    for (int layer = 0; layer < L; layer++) {
+        int type = layer == 0 ? WALL_P : DUMMY_P;
+        double off = (layer + 0.5) * dp;
+        /* corner points belong to the layer of their larger distance */
+        for (long j = 0; j < L + ny; j++) {
+            double y = -L * dp + (j + 0.5) * dp;
+            int t = (y < 0 && (int)floor(-y / dp) > layer) ? DUMMY_P : type;
+            if (push(&b, -off, y, t) || push(&b, W + off, y, t))
+                goto fail;
+        }
+        for (int k = 0; p->tank_lid && k < L; k++) {
+            double y = H + (k + 0.5) * dp;
+            int t = k > layer ? DUMMY_P : type;
+            if (push(&b, -off, y, t) || push(&b, W + off, y, t))
+                goto fail;
+        }
+        for (long i = 0; i < nx; i++) {
+            double x = (i + 0.5) * dp;
+            if (push(&b, x, -off, type))
+                goto fail;
+            if (p->tank_lid && push(&b, x, H + off, type))
+                goto fail;
+        }
+    }
+    *pts = b.a;
+    *nfluid = nf;
+    *nwall = b.n - nf;
+    return 0;
+fail:
+    free(b.a);
+    return -1;
+}
