@@ -15,5 +15,10 @@ const struct mps_key_spec mps_case_common_keys[] = {
     {"output.probe_interval", MPS_KEY_DOUBLE, "0.001", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI,
      NULL, "s", "time between probes.csv rows"},
     {"description", MPS_KEY_STRING, "", 0, 0, 0, NULL, "", "free text"},
+    /* read by the coupler only, declared here so every program accepts them */
+    {"solid_solver", MPS_KEY_STRING, "solid_solver", 0, 0, 0, NULL, "",
+     "command of the solid program (a bare name is looked up beside the coupler first)"},
+    {"fluid_solver", MPS_KEY_STRING, "fluid_solver", 0, 0, 0, NULL, "",
+     "command of the fluid program"},
     {.name = NULL},
 };

@@ -1,3 +1,5 @@
+/* realpath() is XSI */
+#define _XOPEN_SOURCE 700
 #include "mps_cli.h"
 
 #include <errno.h>
@@ -173,4 +175,19 @@ enum mps_status mps_mkdir_p(const char *path, struct mps_err *err)
     }
     free(p);
     return st;
+}
+
+char *mps_realpath(const char *path, char *buf, size_t len)
+{
+    char *r = realpath(path, NULL);
+    if (!r)
+        return NULL;
+    if (strlen(r) >= len) {
+        free(r);
+        errno = ENAMETOOLONG;
+        return NULL;
+    }
+    memcpy(buf, r, strlen(r) + 1);
+    free(r);
+    return buf;
 }

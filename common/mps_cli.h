@@ -5,6 +5,8 @@
 #ifndef MPS_CLI_H
 #define MPS_CLI_H
 
+#include <stddef.h>
+
 #include "mps_err.h"
 
 #define MPS_CLI_MAX_SETS 256
@@ -31,6 +33,10 @@ struct mps_cli {
 enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
                               struct mps_cli_extra *extra, int nextra, const char *usage,
                               struct mps_err *err);
+
+/* Absolute, canonical form of an existing path into buf (size len); NULL on
+ * failure (errno set). */
+char *mps_realpath(const char *path, char *buf, size_t len);
 
 /* Creates a directory and its parents (like mkdir -p). */
 enum mps_status mps_mkdir_p(const char *path, struct mps_err *err);

@@ -109,13 +109,13 @@ size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
             continue;
         double acc[MPS_DIM] = {0}, ntil = 0.0;
         int fluid_nbrs = 0;
-        /* Eq. 50: j* are the fluid and solid surface (and wall) neighbours,
-         * dummy and inner solid particles excluded; n~ (Eq. 51) their weights. */
+        /* Eq. 50: j* are the fluid and solid surface neighbours (walls,
+         * dummy and inner solid particles excluded); n~ (Eq. 51) their weights. */
         if (have_list)
             for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
                 int j = f->nl.j[k];
-                if (!f->has_p[j])
-                    continue;
+                if (!f->is_fluid[j] && f->type[j] != SOLID_SURF_P)
+                    continue; /* walls do not load the solid */
                 double dx[MPS_DIM], r2 = 0.0;
                 for (int d = 0; d < MPS_DIM; d++) {
                     dx[d] = f->x[j][d] - f->x[i][d];

@@ -1,7 +1,9 @@
 /* fluid_solver: the semi-implicit MPS fluid as a program.
  *   fluid_solver CASE.yml --out DIR [--set key=value]... [--quiet]
- * runs a fluid-only case standalone. Exit codes: 0 done, 2 bad input,
- * 1 failure (diverged, I/O, library), 130 interrupted. */
+ * runs a fluid-only case standalone;
+ *   fluid_solver --connect ENDPOINT
+ * runs under the coupler (proto/PROTOCOL.md). Exit codes: 0 done, 2 bad
+ * input, 1 failure (diverged, I/O, library, protocol), 130 interrupted. */
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -16,8 +18,9 @@
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
+#include "proto_solver.h"
 
-static volatile sig_atomic_t stop_signal = 0;
+static volatile int stop_signal = 0;
 
 static void on_signal(int sig)
 {
@@ -32,6 +35,15 @@ struct run {
     const char *out;
     double wall0, t_output;
     int quiet;
+    const char *summary_name;
+    int coupled;
+    struct proto_solver_stats peer;
+    /* loads on the solid surface, sent back each coupled step */
+    int *load_id;
+    double *load_p, (*load_f)[MPS_DIM];
+    size_t load_cap;
+    char out_buf[4096];
+    char probe_names[4096];
 };
 
 static enum mps_status write_snapshot(struct run *r, struct mps_err *err)
@@ -53,29 +65,49 @@ static enum mps_status write_probes(struct run *r, struct mps_err *err)
     return mps_probes_write(r->probes, r->f->time, v, err);
 }
 
-static void write_summary(const struct run *r, enum mps_status st, const struct mps_err *err)
+static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
+                         const struct mps_err *err)
 {
-    char path[4096];
-    snprintf(path, sizeof path, "%s/summary.json", r->out);
-    FILE *fp = fopen(path, "w");
-    if (!fp) {
-        fprintf(stderr, "fluid_solver: warning: cannot write %s\n", path);
-        return;
-    }
     struct mps_json j;
     mps_json_begin(&j, fp);
     mps_json_str(&j, "solver", "fluid_solver");
     mps_json_str(&j, "version", MPS_VERSION);
     mps_json_str(&j, "git_rev", MPS_GIT_REV);
-    mps_json_str(&j, "case", mps_case_path(r->cs));
+    mps_json_str(&j, "case", r->cs ? mps_case_path(r->cs) : "");
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");
     mps_json_num(&j, "wall_seconds", mps_wall_seconds() - r->wall0);
     mps_json_num(&j, "output_seconds", r->t_output);
+    if (r->peer.advances) {
+        mps_json_num(&j, "setup_seconds", r->peer.setup_seconds);
+        mps_json_num(&j, "compute_seconds", r->peer.compute_seconds);
+        mps_json_num(&j, "wait_seconds", r->peer.wait_seconds);
+    }
     if (r->f)
         fluid_summary(r->f, &j);
     mps_json_end(&j);
-    fclose(fp);
+}
+
+/* Writes OUT/<summary_name> and returns the same JSON as a malloc'd string. */
+static char *write_summary(const struct run *r, enum mps_status st, const struct mps_err *err)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/%s", r->out, r->summary_name);
+    FILE *fp = fopen(path, "w");
+    if (fp) {
+        summary_json(r, fp, st, err);
+        fclose(fp);
+    } else {
+        fprintf(stderr, "fluid_solver: warning: cannot write %s\n", path);
+    }
+    char *text = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&text, &len);
+    if (mem) {
+        summary_json(r, mem, st, err);
+        fclose(mem);
+    }
+    return text;
 }
 
 /* The next step: the CFL step, shortened so output times are hit exactly and
@@ -127,14 +159,158 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
     return MPS_OK;
 }
 
+/* Loads the case (validated against the keys this program knows) and
+ * builds the fluid and its outputs. */
+static enum mps_status setup(struct run *r, const char *case_path, const char *const *sets,
+                             int nsets, const char *prefix, struct mps_err *err)
+{
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys};
+    const char *const ignore[] = {"solid.", "coupling.", NULL};
+    enum mps_status st =
+        mps_case_load(&r->cs, case_path, sets, nsets, tables, 2, ignore, err);
+    struct fluid_params prm;
+    if (st || (st = fluid_params_read(&prm, r->cs, err)) || (st = mps_mkdir_p(r->out, err)) ||
+        (st = fluid_create(&r->f, &prm, err)))
+        return st;
+    char *yaml = mps_case_resolved_yaml(r->cs);
+    char path[4200];
+    snprintf(path, sizeof path, "%s/probes.csv", r->out);
+    const char *names[FLUID_MAX_PROBES];
+    for (int k = 0; k < prm.nprobes; k++)
+        names[k] = prm.probes[k].name;
+    proto_join_names(names, prm.nprobes, r->probe_names, sizeof r->probe_names);
+    st = mps_h5_open(&r->h5, r->out, prefix, "fluid_solver", yaml ? yaml : "", err);
+    free(yaml);
+    /* under the coupler, probes travel in RESULT and the coupler writes them */
+    if (!st && !r->coupled)
+        st = mps_probes_open(&r->probes, path, names, prm.nprobes, err);
+    return st;
+}
+
+static enum mps_status peer_configure(void *self, const char *case_path, const char *out_dir,
+                                      const char *prefix, struct mps_err *err)
+{
+    struct run *r = self;
+    snprintf(r->out_buf, sizeof r->out_buf, "%s", out_dir);
+    r->out = r->out_buf;
+    enum mps_status st = setup(r, case_path, NULL, 0, prefix, err);
+    if (!st && r->f->prm.output_interval > 0.0)
+        st = write_snapshot(r, err);
+    return st;
+}
+
+static enum mps_status peer_ready(void *self, struct proto_msg *reply, struct mps_err *err)
+{
+    struct run *r = self;
+    reply->payload = PROTO_NONE;
+    reply->dt = fluid_cfl_dt(r->f);
+    reply->nprobes = r->f->prm.nprobes;
+    reply->text = r->probe_names[0] ? r->probe_names : NULL;
+    return MPS_OK;
+}
+
+static enum mps_status peer_advance(void *self, const struct proto_msg *in,
+                                    struct proto_msg *reply, struct mps_err *err)
+{
+    struct run *r = self;
+    struct fluid *f = r->f;
+    enum mps_status st;
+    if (in->payload == PROTO_STATE &&
+        (st = fluid_set_solid(f, in->count, in->id, in->x, in->v, in->surface, err)))
+        return st;
+    if (in->payload == PROTO_LOADS)
+        return mps_err_set(err, MPS_EPROTO, "the fluid was sent LOADS; it takes STATE or NONE");
+    if ((st = fluid_step(f, in->dt, err)))
+        return st;
+    /* the coupler's clock is the reference: no drift from summing steps */
+    f->time = in->time + in->dt;
+    if (in->count > r->load_cap) {
+        size_t cap = in->count + 64;
+        int *id = realloc(r->load_id, cap * sizeof *id);
+        double *p = realloc(r->load_p, cap * sizeof *p);
+        double(*fo)[MPS_DIM] = realloc(r->load_f, cap * sizeof *fo);
+        if (id)
+            r->load_id = id;
+        if (p)
+            r->load_p = p;
+        if (fo)
+            r->load_f = fo;
+        if (!id || !p || !fo)
+            return mps_err_set(err, MPS_ENOMEM, "fluid: out of memory for %zu loads", cap);
+        r->load_cap = cap;
+    }
+    size_t m = fluid_solid_loads(f, r->load_id, r->load_p, r->load_f, r->load_cap);
+    reply->payload = PROTO_LOADS; /* empty when there is no solid */
+    reply->count = m;
+    reply->id = r->load_id;
+    reply->pressure = r->load_p;
+    reply->force = (const double(*)[MPS_DIM])r->load_f;
+    reply->dt = fluid_cfl_dt(f);
+    if (in->flags & PROTO_F_PROBES) {
+        static double values[FLUID_MAX_PROBES];
+        for (int k = 0; k < f->prm.nprobes; k++)
+            values[k] = fluid_probe(f, k);
+        reply->nprobes = f->prm.nprobes;
+        reply->probes = values;
+    }
+    if (in->flags & PROTO_F_SNAPSHOT)
+        st = write_snapshot(r, err);
+    return st;
+}
+
+static char *peer_finish(void *self, enum mps_status st, const struct mps_err *err)
+{
+    struct run *r = self;
+    return write_summary(r, st, err);
+}
+
+static void teardown(struct run *r)
+{
+    mps_probes_close(&r->probes);
+    mps_h5_close(&r->h5);
+    fluid_destroy(&r->f);
+    mps_case_destroy(&r->cs);
+    free(r->load_id);
+    free(r->load_p);
+    free(r->load_f);
+}
+
+static int run_coupled(const char *endpoint, int hello_timeout_ms)
+{
+    struct run r = {.out = ".", .quiet = 1, .summary_name = "fluid_summary.json", .coupled = 1};
+    r.wall0 = mps_wall_seconds();
+    struct mps_err err = {0};
+    static const struct proto_solver_ops ops = {"fluid", "mps", peer_configure, peer_ready,
+                                                peer_advance, peer_finish};
+    enum mps_status st =
+        proto_solver_run(endpoint, &ops, &r, hello_timeout_ms, &stop_signal, &r.peer, &err);
+    if (st)
+        fprintf(stderr, "fluid_solver: %s: %s\n", mps_status_name(st), err.msg);
+    teardown(&r);
+    return mps_status_exit_code(st);
+}
+
 int main(int argc, char **argv)
 {
     struct mps_err err = {0};
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    const char *endpoint = NULL;
+    int hello_ms = 0;
+    int coupled = proto_solver_args(argc, argv, &endpoint, &hello_ms, &err);
+    if (coupled < 0) {
+        fprintf(stderr, "fluid_solver: %s\n", err.msg);
+        return 2;
+    }
+    if (coupled)
+        return run_coupled(endpoint, hello_ms);
+
     struct mps_cli cli;
     struct mps_cli_extra extra[] = {
         {"--dump-ppe", 1, "write the PPE of step N as Matrix Market files into --out", NULL},
     };
-    const char *usage = "usage: fluid_solver CASE.yml --out DIR [--set key=value]... [--quiet]";
+    const char *usage = "usage: fluid_solver CASE.yml --out DIR [--set key=value]... [--quiet]\n"
+                        "       fluid_solver --connect ENDPOINT [--timeout S]   (under the coupler)";
     enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
     if (st == MPS_EINTR)
         return 0; /* --help */
@@ -142,39 +318,17 @@ int main(int argc, char **argv)
         fprintf(stderr, "fluid_solver: %s\n", err.msg);
         return mps_status_exit_code(st);
     }
-    struct run r = {.out = cli.out_dir ? cli.out_dir : "out", .quiet = cli.quiet};
+    struct run r = {.out = cli.out_dir ? cli.out_dir : "out", .quiet = cli.quiet,
+                    .summary_name = "summary.json"};
     r.wall0 = mps_wall_seconds();
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys};
-    const char *const ignore[] = {"solid.", "coupling.", NULL};
-    st = mps_case_load(&r.cs, cli.case_path, cli.sets, cli.nsets, tables, 2, ignore, &err);
-    if (st) {
-        fprintf(stderr, "fluid_solver: %s\n", err.msg);
-        return mps_status_exit_code(st);
-    }
-    struct fluid_params prm;
-    if ((st = fluid_params_read(&prm, r.cs, &err)) || (st = mps_mkdir_p(r.out, &err)) ||
-        (st = fluid_create(&r.f, &prm, &err))) {
-        fprintf(stderr, "fluid_solver: %s\n", err.msg);
-        mps_case_destroy(&r.cs);
-        return mps_status_exit_code(st);
-    }
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
-
-    char *yaml = mps_case_resolved_yaml(r.cs);
-    char path[4096];
-    snprintf(path, sizeof path, "%s/probes.csv", r.out);
-    const char *names[FLUID_MAX_PROBES];
-    for (int k = 0; k < prm.nprobes; k++)
-        names[k] = prm.probes[k].name;
-    if (!(st = mps_h5_open(&r.h5, r.out, "fluid", "fluid_solver", yaml ? yaml : "", &err)) &&
-        !(st = mps_probes_open(&r.probes, path, names, prm.nprobes, &err))) {
+    st = setup(&r, cli.case_path, cli.sets, cli.nsets, "fluid", &err);
+    if (st == MPS_OK) {
         if (extra[0].value) {
             /* benchmark aid: run to step N and dump its PPE */
             long target = atol(extra[0].value);
             while (!st && r.f->step < target)
                 st = fluid_step(r.f, fluid_cfl_dt(r.f), &err);
-            char mpath[4096], bpath[4096];
+            char mpath[4200], bpath[4200];
             snprintf(mpath, sizeof mpath, "%s/ppe_A.mtx", r.out);
             snprintf(bpath, sizeof bpath, "%s/ppe_b.mtx", r.out);
             if (!st)
@@ -183,13 +337,11 @@ int main(int argc, char **argv)
             st = run_standalone(&r, &err);
         }
     }
-    free(yaml);
     if (st)
-        fprintf(stderr, "\nfluid_solver: %s: %s\n", mps_status_name(st), err.msg);
-    write_summary(&r, st, &err);
-    mps_probes_close(&r.probes);
-    mps_h5_close(&r.h5);
-    fluid_destroy(&r.f);
-    mps_case_destroy(&r.cs);
+        fprintf(stderr, "%sfluid_solver: %s: %s\n", r.f && r.f->step ? "\n" : "",
+                mps_status_name(st), err.msg);
+    if (r.cs && r.out)
+        free(write_summary(&r, st, &err));
+    teardown(&r);
     return mps_status_exit_code(st);
 }

@@ -1,0 +1,160 @@
+#include "launch.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <limits.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/prctl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+
+#define MAX_WORDS 64
+
+/* Splits on blanks; single or double quotes group words (no escapes). */
+static int split_words(char *s, char **words, int max)
+{
+    int n = 0;
+    while (*s) {
+        while (*s == ' ' || *s == '\t')
+            s++;
+        if (!*s)
+            break;
+        if (n == max - 1)
+            return -1;
+        char q = (*s == '"' || *s == '\'') ? *s++ : 0;
+        words[n++] = s;
+        while (*s && (q ? *s != q : (*s != ' ' && *s != '\t')))
+            s++;
+        if (q && !*s)
+            return -2;
+        if (*s)
+            *s++ = '\0';
+    }
+    words[n] = NULL;
+    return n;
+}
+
+/* A bare name is looked up beside the coupler first, so a build tree works
+ * without PATH changes. */
+static void resolve(const char *word, char *out, size_t len)
+{
+    snprintf(out, len, "%s", word);
+    if (strchr(word, '/'))
+        return;
+    char self[PATH_MAX];
+    ssize_t k = readlink("/proc/self/exe", self, sizeof self - 1);
+    if (k <= 0)
+        return;
+    self[k] = '\0';
+    char *slash = strrchr(self, '/');
+    if (!slash)
+        return;
+    *slash = '\0';
+    char cand[PATH_MAX + 256];
+    snprintf(cand, sizeof cand, "%s/%s", self, word);
+    if (access(cand, X_OK) == 0 && strlen(cand) < len)
+        memcpy(out, cand, strlen(cand) + 1);
+}
+
+enum mps_status launch_start(struct child *c, const char *name, const char *command,
+                             const char *endpoint, struct mps_err *err)
+{
+    memset(c, 0, sizeof *c);
+    c->name = name;
+    snprintf(c->command, sizeof c->command, "%s", command);
+    char buf[4096];
+    snprintf(buf, sizeof buf, "%s", command);
+    char *words[MAX_WORDS + 3];
+    int n = split_words(buf, words, MAX_WORDS);
+    if (n <= 0)
+        return mps_err_set(err, MPS_EINPUT, "%s solver command '%s': %s", name, command,
+                           n == 0 ? "empty" : n == -1 ? "too many words" : "unbalanced quote");
+    char prog[PATH_MAX];
+    resolve(words[0], prog, sizeof prog);
+    words[0] = prog;
+    words[n++] = "--connect";
+    words[n++] = (char *)endpoint;
+    words[n] = NULL;
+
+    pid_t parent = getpid();
+    pid_t pid = fork();
+    if (pid < 0)
+        return mps_err_set(err, MPS_EIO, "cannot fork the %s solver: %s", name, strerror(errno));
+    if (pid == 0) {
+        /* child: die with the coupler; keep our own process group out of the
+         * terminal's Ctrl-C so the coupler decides how solvers stop */
+        prctl(PR_SET_PDEATHSIG, SIGTERM);
+        if (getppid() != parent)
+            _exit(126);
+        setpgid(0, 0);
+        execvp(words[0], words);
+        fprintf(stderr, "coupler: cannot start the %s solver '%s': %s\n", name, words[0],
+                strerror(errno));
+        _exit(127);
+    }
+    c->pid = pid;
+    return MPS_OK;
+}
+
+int launch_poll(struct child *c)
+{
+    if (c->exited)
+        return 1;
+    if (c->pid <= 0)
+        return 0;
+    int status;
+    pid_t r = waitpid(c->pid, &status, WNOHANG);
+    if (r == c->pid) {
+        c->exited = 1;
+        c->status = status;
+        return 1;
+    }
+    return 0;
+}
+
+void launch_describe(const struct child *c, char *buf, size_t len)
+{
+    if (!c->exited)
+        snprintf(buf, len, "is still running");
+    else if (WIFEXITED(c->status) && WEXITSTATUS(c->status) == 127)
+        snprintf(buf, len, "could not be started ('%s')", c->command);
+    else if (WIFEXITED(c->status))
+        snprintf(buf, len, "exited with status %d", WEXITSTATUS(c->status));
+    else if (WIFSIGNALED(c->status))
+        snprintf(buf, len, "was killed by signal %d (%s)", WTERMSIG(c->status),
+                 strsignal(WTERMSIG(c->status)));
+    else
+        snprintf(buf, len, "ended (status 0x%x)", c->status);
+}
+
+static void sleep_ms(int ms)
+{
+    struct timespec ts = {ms / 1000, (long)(ms % 1000) * 1000000L};
+    nanosleep(&ts, NULL);
+}
+
+void launch_reap(struct child *c, double grace_s)
+{
+    if (c->pid <= 0)
+        return;
+    for (int k = 0; k < (int)(grace_s * 20) && !launch_poll(c); k++)
+        sleep_ms(50);
+    if (!launch_poll(c)) {
+        kill(c->pid, SIGTERM);
+        for (int k = 0; k < 40 && !launch_poll(c); k++)
+            sleep_ms(50);
+    }
+    if (!launch_poll(c)) {
+        kill(c->pid, SIGKILL);
+        int status;
+        if (waitpid(c->pid, &status, 0) == c->pid) {
+            c->exited = 1;
+            c->status = status;
+        }
+    }
+}

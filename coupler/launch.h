@@ -1,0 +1,34 @@
+/* Starting and watching the solver processes. A solver command is a string
+ * of words ("solid_solver --model tlsph"); a bare program name is looked up
+ * beside the coupler's own executable first, then on PATH. Children get
+ * SIGTERM if the coupler dies (PR_SET_PDEATHSIG), so no solver outlives it. */
+#ifndef LAUNCH_H
+#define LAUNCH_H
+
+#include <sys/types.h>
+
+#include "mps_err.h"
+
+struct child {
+    const char *name;      /* "fluid", "solid" */
+    char command[4096];    /* as given, for messages */
+    pid_t pid;             /* 0: not launched (or external) */
+    int exited;            /* reaped */
+    int status;            /* waitpid status once exited */
+};
+
+/* Launches `command --connect endpoint [--timeout S]`. */
+enum mps_status launch_start(struct child *c, const char *name, const char *command,
+                             const char *endpoint, struct mps_err *err);
+
+/* Reaps the child if it has exited (non-blocking). Returns 1 if it has
+ * exited (now or before), 0 if still running or never launched. */
+int launch_poll(struct child *c);
+
+/* "exited with status 3", "was killed by signal 11 (Segmentation fault)". */
+void launch_describe(const struct child *c, char *buf, size_t len);
+
+/* Waits up to grace_s for the child to exit, then SIGTERM, then SIGKILL. */
+void launch_reap(struct child *c, double grace_s);
+
+#endif

@@ -1,0 +1,223 @@
+#include "proto_solver.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include <zmq.h>
+
+#include "mps_timer.h"
+#include "proto_link.h"
+
+/* The wait for the next message is cut into slices so a signal or the
+ * parent's death is noticed within a second. */
+#define SLICE_MS 1000
+
+static enum mps_status recv_sliced(void *sock, struct proto_msg *m, long timeout_ms,
+                                   volatile const int *stop_flag, pid_t parent,
+                                   struct mps_err *err)
+{
+    long waited = 0;
+    for (;;) {
+        if (stop_flag && *stop_flag)
+            return mps_err_set(err, MPS_EINTR, "interrupted: signal %d", *stop_flag);
+        if (getppid() != parent)
+            return mps_err_set(err, MPS_EPEER, "the coupler (pid %d) is gone", (int)parent);
+        int slice = timeout_ms < 0 || timeout_ms - waited > SLICE_MS ? SLICE_MS
+                                                                     : (int)(timeout_ms - waited);
+        enum mps_status st = proto_link_recv(sock, m, slice, err);
+        if (st == MPS_ETIMEOUT) {
+            waited += slice;
+            if (timeout_ms >= 0 && waited >= timeout_ms)
+                return mps_err_set(err, MPS_ETIMEOUT,
+                                   "no message from the coupler within %ld ms", timeout_ms);
+            continue;
+        }
+        if (st == MPS_EINTR)
+            continue; /* the flag check above decides */
+        return st;
+    }
+}
+
+/* Best effort: tell the coupler why we stop. */
+static void send_error(void *sock, const struct proto_msg *last, enum mps_status st,
+                       const struct mps_err *err)
+{
+    char text[1200];
+    snprintf(text, sizeof text, "%s: %s", mps_status_name(st), err->msg);
+    struct proto_msg e = proto_msg_make(PROTO_ERROR);
+    e.text = text;
+    if (last) {
+        e.step = last->step;
+        e.time = last->time;
+    }
+    struct mps_err ignored;
+    proto_link_send(sock, &e, &ignored);
+}
+
+enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver_ops *ops,
+                                 void *self, int hello_timeout_ms,
+                                 volatile const int *stop_flag, struct proto_solver_stats *stats,
+                                 struct mps_err *err)
+{
+    struct proto_solver_stats local = {0};
+    if (!stats)
+        stats = &local;
+    memset(stats, 0, sizeof *stats);
+    void *ctx = zmq_ctx_new();
+    if (!ctx)
+        return mps_err_set(err, MPS_ELIB, "zmq_ctx_new failed: %s", zmq_strerror(zmq_errno()));
+    void *sock = NULL;
+    pid_t parent = getppid();
+    struct proto_msg in = {0}, reply;
+    int configured = 0, said_error = 0;
+    long timeout_ms = 1800000;
+    enum mps_status st = proto_link_open(ctx, PROTO_LINK_CONNECT, endpoint, &sock, err);
+    if (st)
+        goto done;
+
+    char hello[256];
+    snprintf(hello, sizeof hello, "role=%s model=%s pid=%d build=%s", ops->role, ops->model,
+             (int)getpid(), MPS_VERSION);
+    reply = proto_msg_make(PROTO_HELLO);
+    reply.text = hello;
+    if ((st = proto_link_send(sock, &reply, err)))
+        goto done;
+
+    if ((st = recv_sliced(sock, &in, hello_timeout_ms, stop_flag, parent, err)))
+        goto fail;
+    if (in.type == PROTO_REJECT) {
+        st = mps_err_set(err, MPS_EPROTO, "the coupler refused this solver: %s",
+                         in.text ? in.text : "(no reason)");
+        said_error = 1; /* no reply to a REJECT */
+        goto done;
+    }
+    if (in.type != PROTO_CONFIG) {
+        st = mps_err_set(err, MPS_EPROTO, "expected CONFIG or REJECT after HELLO, got %s",
+                         proto_type_name(in.type));
+        goto fail;
+    }
+    {
+        char case_path[4096], out[4096], prefix[64], tms[64];
+        if (proto_text_get(in.text, '\n', "case", case_path, sizeof case_path) != 1 ||
+            proto_text_get(in.text, '\n', "out", out, sizeof out) != 1 ||
+            proto_text_get(in.text, '\n', "prefix", prefix, sizeof prefix) != 1) {
+            st = mps_err_set(err, MPS_EPROTO, "CONFIG lacks case, out or prefix");
+            goto fail;
+        }
+        if (proto_text_get(in.text, '\n', "timeout_ms", tms, sizeof tms) == 1)
+            timeout_ms = atol(tms);
+        double t0 = mps_wall_seconds();
+        st = ops->configure(self, case_path, out, prefix, err);
+        configured = 1;
+        if (st)
+            goto fail;
+        reply = proto_msg_make(PROTO_READY);
+        st = ops->ready(self, &reply, err);
+        stats->setup_seconds += mps_wall_seconds() - t0;
+        if (st || (st = proto_link_send(sock, &reply, err)))
+            goto fail;
+    }
+
+    for (;;) {
+        proto_msg_clear(&in);
+        double t0 = mps_wall_seconds();
+        st = recv_sliced(sock, &in, timeout_ms, stop_flag, parent, err);
+        stats->wait_seconds += mps_wall_seconds() - t0;
+        if (st)
+            goto fail;
+        if (in.type == PROTO_ABORT) {
+            st = mps_err_set(err, MPS_EPEER, "aborted by the coupler: %s",
+                             in.text ? in.text : "(no reason)");
+            said_error = 1; /* no reply to ABORT */
+            goto done;
+        }
+        if (in.type == PROTO_STOP) {
+            char *json = ops->finish(self, MPS_OK, err);
+            configured = 0;
+            reply = proto_msg_make(PROTO_BYE);
+            reply.step = in.step;
+            reply.time = in.time;
+            reply.text = json ? json : "{}";
+            st = proto_link_send(sock, &reply, err);
+            free(json);
+            goto done;
+        }
+        if (in.type != PROTO_ADVANCE) {
+            st = mps_err_set(err, MPS_EPROTO, "expected ADVANCE, STOP or ABORT, got %s",
+                             proto_type_name(in.type));
+            goto fail;
+        }
+        t0 = mps_wall_seconds();
+        reply = proto_msg_make(PROTO_RESULT);
+        st = ops->advance(self, &in, &reply, err);
+        stats->compute_seconds += mps_wall_seconds() - t0;
+        stats->advances++;
+        if (st)
+            goto fail;
+        reply.type = PROTO_RESULT;
+        reply.step = in.step;
+        reply.iteration = in.iteration;
+        reply.time = in.time + in.dt; /* one addition, as PROTOCOL.md 6 asks */
+        reply.flags = in.flags & PROTO_F_PROBES;
+        if ((st = proto_link_send(sock, &reply, err)))
+            goto fail;
+    }
+
+fail:
+    if (sock && !said_error && st != MPS_EPEER)
+        send_error(sock, &in, st, err);
+done:
+    if (configured) {
+        char *json = ops->finish(self, st, err);
+        free(json);
+    }
+    proto_msg_clear(&in);
+    proto_link_close(&sock);
+    zmq_ctx_term(ctx);
+    return st;
+}
+
+int proto_solver_args(int argc, char **argv, const char **endpoint, int *hello_timeout_ms,
+                      struct mps_err *err)
+{
+    int found = 0;
+    *hello_timeout_ms = 60000;
+    for (int i = 1; i < argc; i++) {
+        if (strcmp(argv[i], "--connect") == 0) {
+            if (i + 1 >= argc) {
+                mps_err_set(err, MPS_EINPUT, "--connect needs an endpoint (ipc://... or tcp://...)");
+                return -1;
+            }
+            *endpoint = argv[++i];
+            found = 1;
+        } else if (strcmp(argv[i], "--timeout") == 0) {
+            char *end;
+            double s = i + 1 < argc ? strtod(argv[i + 1], &end) : 0.0;
+            if (i + 1 >= argc || *end || !(s > 0.0) || s > 1e6) {
+                mps_err_set(err, MPS_EINPUT, "--timeout needs seconds > 0");
+                return -1;
+            }
+            *hello_timeout_ms = (int)(s * 1000.0);
+            i++;
+        } else if (strcmp(argv[i], "--quiet") == 0) {
+            continue;
+        } else if (found) {
+            mps_err_set(err, MPS_EINPUT,
+                        "'%s': a coupled solver takes only --connect, --timeout and --quiet "
+                        "(the case comes from the coupler)",
+                        argv[i]);
+            return -1;
+        }
+    }
+    return found;
+}
+
+char *proto_join_names(const char *const *names, int n, char *buf, size_t len)
+{
+    size_t used = 0;
+    buf[0] = '\0';
+    for (int k = 0; k < n && used < len; k++)
+        used += (size_t)snprintf(buf + used, len - used, "%s%s", k ? "," : "", names[k]);
+    return buf;
+}

@@ -1,0 +1,60 @@
+/* The solver side of the coupling protocol (PROTOCOL.md sections 6-8) as one
+ * loop, so every solver program in C runs the same conversation: HELLO,
+ * CONFIG -> configure, READY, then ADVANCE -> advance / RESULT until STOP ->
+ * BYE, with ERROR on any failure and a prompt exit on ABORT or a lost coupler.
+ * A solver supplies its physics through these callbacks. */
+#ifndef PROTO_SOLVER_H
+#define PROTO_SOLVER_H
+
+#include "mps_err.h"
+#include "proto_msg.h"
+
+struct proto_solver_ops {
+    const char *role;    /* "fluid" or "solid" */
+    const char *model;   /* "mps", "tlsph", ... */
+    /* CONFIG: read the resolved case, build particles, open outputs (prefix
+     * names them), write the initial snapshot. */
+    enum mps_status (*configure)(void *self, const char *case_path, const char *out_dir,
+                                 const char *prefix, struct mps_err *err);
+    /* READY: fill payload (the solid's interface, or NONE), dt (own stable
+     * step), nprobes and text (comma-separated probe names). Pointers in
+     * reply stay owned by the solver until the next callback. */
+    enum mps_status (*ready)(void *self, struct proto_msg *reply, struct mps_err *err);
+    /* ADVANCE: take the step described by in (payload, time, dt, n_sub),
+     * write a snapshot if in->flags has PROTO_F_SNAPSHOT, and fill reply's
+     * payload, dt (next stable step) and, with PROTO_F_PROBES, nprobes and
+     * probes. The loop fills type, step, iteration, time and flags. */
+    enum mps_status (*advance)(void *self, const struct proto_msg *in, struct proto_msg *reply,
+                               struct mps_err *err);
+    /* STOP: finish outputs; return the summary as a malloc'd JSON object. */
+    char *(*finish)(void *self, enum mps_status st, const struct mps_err *err);
+};
+
+/* Timing of the conversation, for the solver's summary. */
+struct proto_solver_stats {
+    double setup_seconds;     /* inside configure/ready */
+    double compute_seconds;   /* inside advance */
+    double wait_seconds;      /* waiting for the coupler */
+    long advances;
+};
+
+/* Runs the conversation on endpoint until STOP (MPS_OK), ABORT (MPS_EPEER),
+ * an error (sent to the coupler as ERROR when possible) or a signal
+ * (*stop_flag set by the caller's handler: MPS_EINTR). hello_timeout_ms
+ * bounds the wait for CONFIG. On error, finish() is still called so the
+ * outputs are flushed. */
+enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver_ops *ops,
+                                 void *self, int hello_timeout_ms,
+                                 volatile const int *stop_flag, struct proto_solver_stats *stats,
+                                 struct mps_err *err);
+
+/* Solver programs run coupled as `PROGRAM --connect ENDPOINT [--timeout S]
+ * [--quiet]`. Returns 1 and fills endpoint / hello_timeout_ms if argv holds
+ * --connect, 0 if not, -1 (err set) if the coupled arguments are malformed. */
+int proto_solver_args(int argc, char **argv, const char **endpoint, int *hello_timeout_ms,
+                      struct mps_err *err);
+
+/* "a,b,c" from n names into buf (size len); returns buf. */
+char *proto_join_names(const char *const *names, int n, char *buf, size_t len);
+
+#endif

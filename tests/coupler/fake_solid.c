@@ -1,0 +1,183 @@
+/* A fake solid for coupling tests (no solid physics): the first body of the
+ * case as a rigid lattice of particles moving on a prescribed path
+ *   x(t) = x0 + A sin(2 pi f t),
+ * that reports the total fluid force it receives as probes. It speaks the
+ * protocol through proto_solver like the real solids do.
+ *   fake_solid [--amplitude A] [--frequency F] [--fail-at T] [--version V]
+ *              --connect ENDPOINT
+ * --fail-at T makes it crash (abort) at time T, for the coupler's failure
+ * tests; --hang-at T makes it stop answering. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "mps_case.h"
+#include "mps_cli.h"
+#include "proto_solver.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+#include "solid_scene.h"
+
+struct fake {
+    double amp, freq, fail_at, hang_at;
+    double dp;
+    size_t n;
+    int *id;
+    double (*x0)[2], (*x)[2], (*v)[2];
+    unsigned char *surface, *fixed;
+    double force[2];
+    double t;
+};
+
+static void place(struct fake *s, double t)
+{
+    double w = 2.0 * M_PI * s->freq;
+    double dx = s->amp * sin(w * t), vx = s->amp * w * cos(w * t);
+    for (size_t i = 0; i < s->n; i++) {
+        s->x[i][0] = s->x0[i][0] + dx;
+        s->x[i][1] = s->x0[i][1];
+        s->v[i][0] = vx;
+        s->v[i][1] = 0.0;
+    }
+}
+
+static enum mps_status configure(void *self, const char *case_path, const char *out,
+                                 const char *prefix, struct mps_err *err)
+{
+    struct fake *s = self;
+    struct mps_case *c = NULL;
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const char *const ignore[] = {"fluid.", "coupling.", NULL};
+    enum mps_status st = mps_case_load(&c, case_path, NULL, 0, tables, 2, ignore, err);
+    if (st)
+        return st;
+    s->dp = mps_case_double(c, "dp");
+    double b[4] = {mps_case_double(c, "solid.bodies.0.x0"), mps_case_double(c, "solid.bodies.0.y0"),
+                   mps_case_double(c, "solid.bodies.0.x1"), mps_case_double(c, "solid.bodies.0.y1")};
+    mps_case_destroy(&c);
+    long nx = (long)floor((b[2] - b[0]) / s->dp + 1e-6), ny = (long)floor((b[3] - b[1]) / s->dp + 1e-6);
+    s->n = (size_t)(nx * ny);
+    s->id = calloc(s->n, sizeof *s->id);
+    s->x0 = calloc(s->n, sizeof *s->x0);
+    s->x = calloc(s->n, sizeof *s->x);
+    s->v = calloc(s->n, sizeof *s->v);
+    s->surface = calloc(s->n, 1);
+    s->fixed = calloc(s->n, 1);
+    if (!s->id || !s->x0 || !s->x || !s->v || !s->surface || !s->fixed)
+        return mps_err_set(err, MPS_ENOMEM, "fake solid: out of memory");
+    size_t k = 0;
+    for (long j = 0; j < ny; j++)
+        for (long i = 0; i < nx; i++, k++) {
+            s->id[k] = (int)k;
+            s->x0[k][0] = b[0] + (i + 0.5) * s->dp;
+            s->x0[k][1] = b[1] + (j + 0.5) * s->dp;
+            s->surface[k] = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
+        }
+    place(s, 0.0);
+    (void)out;
+    (void)prefix;
+    return MPS_OK;
+}
+
+static void fill_state(struct fake *s, struct proto_msg *m)
+{
+    m->payload = PROTO_STATE;
+    m->count = s->n;
+    m->id = s->id;
+    m->x = (const double(*)[2])s->x;
+    m->v = (const double(*)[2])s->v;
+    m->surface = s->surface;
+    m->fixed = s->fixed;
+    m->dt = 1.0; /* a rigid path has no stability limit */
+}
+
+static enum mps_status ready(void *self, struct proto_msg *reply, struct mps_err *err)
+{
+    fill_state(self, reply);
+    reply->nprobes = 3;
+    reply->text = "plate_fx,plate_fy,plate_dx";
+    (void)err;
+    return MPS_OK;
+}
+
+static enum mps_status advance(void *self, const struct proto_msg *in, struct proto_msg *reply,
+                               struct mps_err *err)
+{
+    struct fake *s = self;
+    if (s->fail_at >= 0.0 && in->time >= s->fail_at)
+        abort(); /* a crash, as a buggy solver would */
+    if (s->hang_at >= 0.0 && in->time >= s->hang_at)
+        for (;;)
+            pause();
+    s->force[0] = s->force[1] = 0.0;
+    if (in->payload == PROTO_LOADS)
+        for (size_t k = 0; k < in->count; k++) {
+            s->force[0] += in->force[k][0];
+            s->force[1] += in->force[k][1];
+        }
+    s->t = in->time + in->dt;
+    place(s, s->t);
+    fill_state(s, reply);
+    static double probes[3];
+    probes[0] = s->force[0];
+    probes[1] = s->force[1];
+    probes[2] = s->x[0][0] - s->x0[0][0];
+    if (in->flags & PROTO_F_PROBES) {
+        reply->nprobes = 3;
+        reply->probes = probes;
+    }
+    (void)err;
+    return MPS_OK;
+}
+
+static struct proto_solver_stats stats;
+
+static char *finish(void *self, enum mps_status st, const struct mps_err *err)
+{
+    (void)self;
+    (void)err;
+    char *j = malloc(256);
+    if (j)
+        snprintf(j, 256, "{\"solver\": \"fake_solid\", \"status\": \"%s\", \"compute_seconds\": %.9g}",
+                 mps_status_name(st), stats.compute_seconds);
+    return j;
+}
+
+static volatile int stop_flag = 0;
+
+int main(int argc, char **argv)
+{
+    struct fake s = {.amp = 0.0, .freq = 1.0, .fail_at = -1.0, .hang_at = -1.0};
+    for (int i = 1; i + 1 < argc; i++) {
+        if (!strcmp(argv[i], "--amplitude"))
+            s.amp = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--frequency"))
+            s.freq = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--fail-at"))
+            s.fail_at = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--hang-at"))
+            s.hang_at = atof(argv[++i]);
+    }
+    const char *endpoint = NULL;
+    int hello_ms;
+    struct mps_err err = {0};
+    if (proto_solver_args(argc, argv, &endpoint, &hello_ms, &err) != 1) {
+        fprintf(stderr, "fake_solid: %s\n", err.msg[0] ? err.msg : "needs --connect ENDPOINT");
+        return 2;
+    }
+    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready, advance, finish};
+    enum mps_status st = proto_solver_run(endpoint, &ops, &s, hello_ms, &stop_flag, &stats, &err);
+    if (st)
+        fprintf(stderr, "fake_solid: %s: %s\n", mps_status_name(st), err.msg);
+    free(s.id);
+    free(s.x0);
+    free(s.x);
+    free(s.v);
+    free(s.surface);
+    free(s.fixed);
+    return mps_status_exit_code(st);
+}
