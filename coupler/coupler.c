@@ -501,6 +501,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
         mps_json_object(&j, p->name);
         mps_json_str(&j, "command", p->child.command);
         mps_json_str(&j, "endpoint", p->endpoint);
+        mps_json_int(&j, "pid", (long long)p->child.pid);
         mps_json_int(&j, "exchanges", p->exchanges);
         mps_json_num(&j, "roundtrip_seconds", p->roundtrip_seconds);
         mps_json_close(&j);

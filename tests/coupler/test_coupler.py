@@ -1,0 +1,180 @@
+#!/usr/bin/python3
+"""Coupler integration tests: a three-process run with a fake solid, and
+every failure the coupler must handle without hanging.
+
+usage: test_coupler.py BUILD_BIN_DIR TEST_NAME
+Each test prints what it checked and exits non-zero on failure."""
+import csv, glob, json, os, signal, subprocess, sys, tempfile, time
+
+import h5py
+
+BIN = os.path.abspath(sys.argv[1])
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+SCENE = os.path.join(ROOT, 'tests', 'coupler', 'plate_in_water.yml')
+COUPLER = os.path.join(BIN, 'coupler')
+failures = []
+
+
+def check(cond, what):
+    print(('ok    ' if cond else 'FAIL  ') + what)
+    if not cond:
+        failures.append(what)
+
+
+def run(args, timeout=120, **kw):
+    p = subprocess.run([COUPLER] + args, capture_output=True, text=True, timeout=timeout, **kw)
+    return p.returncode, p.stderr
+
+
+def probes(out):
+    with open(os.path.join(out, 'probes.csv')) as f:
+        return list(csv.DictReader(f))
+
+
+def solver_pids(out):
+    with open(os.path.join(out, 'summary.json')) as f:
+        s = json.load(f)
+    return [v['pid'] for v in s['solvers'].values() if v.get('pid')]
+
+
+def gone(pid):
+    try:
+        os.kill(pid, 0)
+        return False
+    except ProcessLookupError:
+        return True
+
+
+def h5_readable(out):
+    files = sorted(glob.glob(os.path.join(out, '*.h5')))
+    for f in files:
+        with h5py.File(f, 'r') as h:
+            h['particles/position'][:]
+    return len(files)
+
+
+def after_failure(out, rc, err, pattern, code=None):
+    check(rc != 0 if code is None else rc == code, f'exit status {rc} (expected {"non-zero" if code is None else code})')
+    check(pattern in err, f'stderr names the cause: {pattern!r}')
+    pids = solver_pids(out)
+    check(all(gone(p) for p in pids), f'no solver left running ({pids})')
+    try:
+        n = h5_readable(out)
+        check(n >= 1, f'{n} HDF5 snapshots written so far are readable')
+    except Exception as e:  # noqa: BLE001
+        check(False, f'HDF5 readable: {e}')
+
+
+def t_plate_force():
+    """Still water against a rigid plate: the fluid's loads (Eq. 50-51) must
+    add up to the hydrostatic force rho g h^2 / 2 = 196.2 N/m (h = 0.2 m).
+    The top particle layer is the free surface (P = 0 at its centres, dp/2
+    below the water line), which puts the discrete force at
+    rho g (h - dp/2)^2 / 2 = 186.5 N/m: the band [0.93, 1.05] x 196.2 covers
+    both readings and the MPS pressure noise."""
+    out = tempfile.mkdtemp(prefix='cpl_plate_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid', '--set', 'end_time=0.4'])
+    check(rc == 0, f'coupled run exits 0 ({err.strip()[-200:]})')
+    rows = [r for r in probes(out) if float(r['time']) >= 0.1]
+    fx = sum(float(r['plate_fx']) for r in rows) / len(rows)
+    exact = 1000 * 9.81 * 0.2 ** 2 / 2
+    check(0.93 * exact <= fx <= 1.05 * exact, f'mean plate force {fx:.1f} N/m vs rho g h^2/2 = {exact:.1f}')
+    s = json.load(open(os.path.join(out, 'summary.json')))
+    check(s['status'] == 'ok', 'summary status ok')
+    check(s['solvers']['solid']['exchanges'] == s['coupling_steps'], 'one solid exchange per fluid step')
+    check(os.path.exists(os.path.join(out, 'scene.xmf')), 'scene.xmf written')
+
+
+def t_moving_plate():
+    """A plate oscillating on a prescribed path pushes water: the force on it
+    must vary with the motion, and the fluid must not leak through it."""
+    out = tempfile.mkdtemp(prefix='cpl_move_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid --amplitude 0.01 --frequency 4',
+                   '--set', 'end_time=0.3'])
+    check(rc == 0, f'coupled run with a moving plate exits 0 ({err.strip()[-200:]})')
+    rows = probes(out)
+    dx = [float(r['plate_dx']) for r in rows]
+    fx = [float(r['plate_fx']) for r in rows if float(r['time']) > 0.05]
+    check(max(dx) > 0.009 and min(dx) < -0.009, f'plate followed its path (dx in [{min(dx):.4f}, {max(dx):.4f}])')
+    check(max(fx) - min(fx) > 20.0, f'load responds to the motion (fx range {min(fx):.0f}..{max(fx):.0f} N/m)')
+
+
+def t_solid_crash():
+    out = tempfile.mkdtemp(prefix='cpl_crash_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid --fail-at 0.03'])
+    after_failure(out, rc, err, 'solid solver was killed by signal 6')
+
+
+def t_solid_hang():
+    out = tempfile.mkdtemp(prefix='cpl_hang_')
+    t0 = time.time()
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid --hang-at 0.03',
+                   '--set', 'coupling.step_timeout=2'])
+    after_failure(out, rc, err, 'solid solver did not answer within 2 s')
+    check(time.time() - t0 < 30, 'the hang is noticed at the deadline')
+
+
+def t_fluid_killed():
+    out = tempfile.mkdtemp(prefix='cpl_kill_')
+    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid'],
+                         stderr=subprocess.PIPE, text=True)
+    pid = None
+    for _ in range(300):
+        time.sleep(0.1)
+        if os.path.exists(os.path.join(out, 'probes.csv')) and len(probes(out)) > 3:
+            break
+    # the fluid is the coupler's child whose command line says fluid_solver
+    kids = subprocess.run(['pgrep', '-P', str(p.pid)], capture_output=True, text=True).stdout.split()
+    for k in kids:
+        with open(f'/proc/{k}/cmdline', 'rb') as f:
+            if b'fluid_solver' in f.read():
+                pid = int(k)
+    check(pid is not None, 'found the running fluid solver')
+    if pid:
+        os.kill(pid, signal.SIGKILL)
+    err = p.communicate(timeout=60)[1]
+    after_failure(out, p.returncode, err, 'fluid solver was killed by signal 9')
+
+
+def t_interrupt():
+    out = tempfile.mkdtemp(prefix='cpl_int_')
+    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid'],
+                         stderr=subprocess.PIPE, text=True)
+    for _ in range(300):
+        time.sleep(0.1)
+        if os.path.exists(os.path.join(out, 'probes.csv')) and len(probes(out)) > 3:
+            break
+    p.send_signal(signal.SIGINT)
+    err = p.communicate(timeout=60)[1]
+    after_failure(out, p.returncode, err, 'interrupted', code=130)
+
+
+def t_fluid_fails():
+    """A fluid that fails (here its PPE solver is starved of iterations)
+    reports ERROR; the coupler names it and the reason."""
+    out = tempfile.mkdtemp(prefix='cpl_ffail_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                   '--set', 'fluid.ppe_max_iter=1', '--set', 'fluid.ppe_rtol=1e-14',
+                   '--set', 'fluid.ppe_solver=pcg_jacobi'])
+    after_failure(out, rc, err, 'fluid solver: solver:')
+
+
+def t_wrong_version():
+    out = tempfile.mkdtemp(prefix='cpl_ver_')
+    report = os.path.join(out, 'solver_report.txt')
+    solver = os.path.join(ROOT, 'tests', 'coupler', 'bad_version_solver.py')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', f'/usr/bin/python3 {solver} {report}'])
+    check(rc != 0, f'coupler refuses the solver (exit {rc})')
+    check('protocol version 2 received, this build speaks version 1' in err,
+          'coupler says which versions')
+    told = open(report).read() if os.path.exists(report) else ''
+    check(told.startswith('REJECT') and 'version 2' in told, f'solver was told: {told.strip()}')
+
+
+TESTS = {k[2:]: v for k, v in globals().items() if k.startswith('t_')}
+
+if __name__ == '__main__':
+    name = sys.argv[2]
+    TESTS[name]()
+    print(f'{name}: {len(failures)} failed')
+    sys.exit(1 if failures else 0)
