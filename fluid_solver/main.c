@@ -340,7 +340,7 @@ int main(int argc, char **argv)
     if (st)
         fprintf(stderr, "%sfluid_solver: %s: %s\n", r.f && r.f->step ? "\n" : "",
                 mps_status_name(st), err.msg);
-    if (r.cs && r.out)
+    if (r.f) /* a run that started leaves its summary, even a failed one */
         free(write_summary(&r, st, &err));
     teardown(&r);
     return mps_status_exit_code(st);

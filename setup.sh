@@ -1,0 +1,30 @@
+#!/bin/sh
+# Installs the build dependencies (Debian 12 packages; needs root or sudo when
+# something is missing) and builds everything in build/ (Release).
+#   ./setup.sh            install what is missing, configure, build
+#   ./setup.sh --debug    same, Debug with address/undefined sanitizers in build-debug/
+set -eu
+cd "$(dirname "$0")"
+
+PKGS="build-essential cmake pkg-config libzmq3-dev libhdf5-dev libsuitesparse-dev \
+libopenblas-dev libyaml-dev python3 python3-numpy python3-zmq python3-h5py python3-matplotlib"
+
+missing=""
+for p in $PKGS; do
+    dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+    echo "setup: installing$missing"
+    SUDO=""
+    [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+    $SUDO apt-get update -qq
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing
+fi
+
+if [ "${1:-}" = "--debug" ]; then
+    cmake -S . -B build-debug -DCMAKE_BUILD_TYPE=Debug -DMPS_SANITIZE=ON
+    cmake --build build-debug -j"$(nproc)"
+else
+    cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+    cmake --build build -j"$(nproc)"
+fi

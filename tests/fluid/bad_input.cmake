@@ -1,0 +1,30 @@
+# Bad input to the fluid solver and to the coupler: one clear line naming the
+# file/key and the problem, and a non-zero exit (tests/expect_fail.sh).
+function(fluid_expect_fail name pattern)
+  add_test(NAME ${name}
+           COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh "${pattern}" ${ARGN}
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(${name} PROPERTIES TIMEOUT 30 LABELS unit)
+endfunction()
+
+set(FS ${CMAKE_BINARY_DIR}/bin/fluid_solver)
+set(DB cases/dambreak/case.yml)
+set(OUT --out ${CMAKE_BINARY_DIR}/test_out/bad_input)
+fluid_expect_fail(fluid_bad_missing_file "cases/no_such_case.yml: cannot open: No such file"
+                  ${FS} cases/no_such_case.yml ${OUT})
+fluid_expect_fail(fluid_bad_unknown_key "--set fluid.rhoo=1: fluid.rhoo = 1: unknown key; did you mean fluid.rho"
+                  ${FS} ${DB} ${OUT} --set fluid.rhoo=1)
+fluid_expect_fail(fluid_bad_negative_dp "dp = -0.004: must be > 0"
+                  ${FS} ${DB} ${OUT} --set dp=-0.004)
+fluid_expect_fail(fluid_bad_block_outside "fluid.blocks.0.x1 = 0.7: the water block lies outside the tank"
+                  ${FS} ${DB} ${OUT} --set fluid.blocks.0.x1=0.7)
+fluid_expect_fail(fluid_bad_end_time_zero "end_time = 0: must be > 0"
+                  ${FS} ${DB} ${OUT} --set end_time=0)
+fluid_expect_fail(fluid_bad_cfl "fluid.dt_min = 0.01: the CFL condition \\(Eq. 52\\) needs dt <="
+                  ${FS} ${DB} ${OUT} --set fluid.dt_min=0.01 --set fluid.dt_max=0.02)
+fluid_expect_fail(fluid_bad_unknown_key_in_file "tests/fluid/bad_key.yml:6: fluid.bogus = 1: unknown key"
+                  ${FS} tests/fluid/bad_key.yml ${OUT})
+fluid_expect_fail(coupler_bad_negative_dp "coupler: .*dp = -0.004: must be > 0"
+                  ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set dp=-0.004)
+fluid_expect_fail(coupler_bad_no_scene "neither a fluid .* nor a solid"
+                  ${CMAKE_BINARY_DIR}/bin/coupler tests/fluid/empty_case.yml ${OUT})
