@@ -1,0 +1,67 @@
+#!/usr/bin/python3
+"""Fluid solver speed: time per particle-step and its split, as N grows.
+
+usage: bench/fluid_speed.py [--bin build/bin] [--threads 1,2] [--out docs/fluid_speed.md]
+Runs the dam break (cases/dambreak) at spacings that give about 5k, 20k and
+80k particles (fluid + wall + dummy) for a short, fixed simulated time, once
+per thread count, and tabulates ns per particle-step by phase from each run's
+summary.json. Also times the paper's coarsest dam break (dp = 3 mm, 4,656
+fluid particles) over 1 s of simulated time. Run it on a quiet machine."""
+import argparse, json, os, subprocess, tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def run(binary, dp, end, threads, extra=()):
+    out = tempfile.mkdtemp(prefix='fspeed_')
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    cmd = [os.path.join(binary, 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
+           '--out', out, '--quiet', '--set', f'dp={dp}', '--set', f'end_time={end}',
+           '--set', 'output.interval=0', *extra]
+    subprocess.run(cmd, check=True, env=env)
+    with open(os.path.join(out, 'summary.json')) as f:
+        return json.load(f), ' '.join(cmd[1:]).replace(ROOT + '/', '')
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--bin', default=os.path.join(ROOT, 'build', 'bin'))
+    ap.add_argument('--threads', default='1,2')
+    ap.add_argument('--out', default=os.path.join(ROOT, 'docs', 'fluid_speed.md'))
+    ap.add_argument('--sizes', default='0.0035,0.0018,0.0009')
+    args = ap.parse_args()
+    threads = [int(t) for t in args.threads.split(',')]
+    phases = ['neighbours', 'predict', 'density', 'ppe_assemble', 'ppe_solve', 'correct', 'other']
+    lines = ['# Fluid solver speed', '',
+             'Reproduce: `bench/fluid_speed.py` (Release build, quiet 2-core machine).', '',
+             'Dam break (`cases/dambreak`) over a short simulated time; N counts fluid, wall and '
+             'dummy particles; ns per particle-step by phase (from `summary.json`).', '',
+             '| dp (mm) | N | threads | steps | PPE iters/step | ' + ' | '.join(phases) +
+             ' | total ns/particle-step |',
+             '|' + '---|' * (len(phases) + 6)]
+    for dp in [float(s) for s in args.sizes.split(',')]:
+        end = 0.02 if dp > 0.001 else 0.01
+        for t in threads:
+            s, _ = run(args.bin, dp, end, t)
+            n = s['particles']['total']
+            ps = s['steps'] * n
+            cells = [f"{1e9 * s['phase_seconds'][p] / ps:.0f}" for p in phases]
+            lines.append(f"| {dp * 1e3:.2f} | {n} | {t} | {s['steps']} | "
+                         f"{s['ppe_iterations_per_step']:.1f} | " + ' | '.join(cells) +
+                         f" | {s['ns_per_particle_step']:.0f} |")
+    lines += ['', '## The paper\'s coarsest dam break: 1 s of simulated time', '',
+              '| dp (mm) | fluid particles | threads | steps | wall s | ns/particle-step |',
+              '|---|---|---|---|---|---|']
+    for t in threads:
+        s, cmd = run(args.bin, 0.003, 1.0, t)
+        lines.append(f"| 3.00 | {s['particles']['fluid']} | {t} | {s['steps']} | "
+                     f"{s['wall_seconds']:.1f} | {s['ns_per_particle_step']:.0f} |")
+    lines += ['', f'Command of the last row: `OMP_NUM_THREADS={threads[-1]} build/bin/{cmd}`', '']
+    os.makedirs(os.path.dirname(args.out), exist_ok=True)
+    with open(args.out, 'w') as f:
+        f.write('\n'.join(lines))
+    print('\n'.join(lines))
+
+
+if __name__ == '__main__':
+    main()

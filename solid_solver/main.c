@@ -1,0 +1,272 @@
+/* solid_solver: the solid alone.
+ *   solid_solver CASE.yml --out DIR [--set key=value]... [--quiet] [--model NAME]
+ * Steps the chosen model with its own stable step up to end_time, landing
+ * exactly on every snapshot and probe time, and writes DIR/solid_*.h5 +
+ * solid.xmf, DIR/probes.csv and DIR/summary.json. */
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mps_case.h"
+#include "mps_cli.h"
+#include "mps_h5.h"
+#include "mps_json.h"
+#include "mps_probes.h"
+#include "mps_progress.h"
+#include "mps_timer.h"
+#include "proto_solver.h"
+#include "solid_model.h"
+#include "solid_peer.h"
+#include "solid_scene.h"
+
+static const char usage[] =
+    "usage: solid_solver CASE.yml --out DIR [--set key=value]... [--quiet] [--model NAME]\n"
+    "Runs the elastic solid of a case alone (keys dp, end_time, gravity.*, output.*, solid.*).";
+
+#define MAX_FIELDS 24
+
+struct run {
+    const struct solid_model_ops *ops;
+    void *model;
+    struct mps_h5_series *h5;
+    struct mps_probes *probes;
+    double *pvals;
+    int nprobes;
+    double t_output;   /* wall seconds spent writing */
+};
+
+static enum mps_status write_snapshot(struct run *r, double t, long step, struct mps_err *err)
+{
+    double w0 = mps_wall_seconds();
+    const double(*x)[MPS_DIM] = NULL;
+    struct mps_field f[MAX_FIELDS];
+    int nf = 0;
+    size_t n = r->ops->snapshot(r->model, &x, f, MAX_FIELDS, &nf);
+    enum mps_status st = mps_h5_write(r->h5, t, step, n, x, f, nf, err);
+    r->t_output += mps_wall_seconds() - w0;
+    return st;
+}
+
+static enum mps_status write_probes(struct run *r, double t, struct mps_err *err)
+{
+    for (int k = 0; k < r->nprobes; k++)
+        r->pvals[k] = r->ops->probe_value(r->model, k);
+    return mps_probes_write(r->probes, t, r->pvals, err);
+}
+
+static enum mps_status write_summary(const struct run *r, const struct mps_case *c,
+                                     const char *dir, size_t n, long steps, double t,
+                                     double wall_loop, double wall_total, struct mps_err *err)
+{
+    char path[4096];
+    snprintf(path, sizeof path, "%s/summary.json", dir);
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return mps_err_set(err, MPS_EIO, "cannot create '%s'", path);
+    struct mps_json j;
+    mps_json_begin(&j, f);
+    mps_json_str(&j, "solver", "solid_solver");
+    mps_json_str(&j, "version", MPS_VERSION);
+    mps_json_str(&j, "git_rev", MPS_GIT_REV);
+    mps_json_str(&j, "case", mps_case_path(c));
+    mps_json_int(&j, "particles", (long long)n);
+    mps_json_int(&j, "steps", steps);
+    mps_json_num(&j, "time", t);
+    mps_json_num(&j, "wall_seconds", wall_total);
+    mps_json_num(&j, "step_seconds", wall_loop);
+    mps_json_num(&j, "output_seconds", r->t_output);
+    double ps = (double)n * (double)steps;
+    mps_json_num(&j, "ns_per_particle_step", ps > 0 ? 1e9 * wall_loop / ps : NAN);
+    mps_json_num(&j, "particle_steps_per_second", wall_loop > 0 ? ps / wall_loop : NAN);
+    mps_json_object(&j, "solid");
+    r->ops->summary(r->model, &j);
+    mps_json_close(&j);
+    mps_json_object(&j, "probes");
+    for (int k = 0; k < r->nprobes; k++)
+        mps_json_num(&j, r->ops->probe_name(r->model, k), r->pvals[k]);
+    mps_json_close(&j);
+    mps_json_end(&j);
+    if (fclose(f) != 0)
+        return mps_err_set(err, MPS_EIO, "cannot write '%s'", path);
+    return MPS_OK;
+}
+
+/* k-th event time of a period (products, not sums: no drift). */
+static double event(long k, double period)
+{
+    return period > 0.0 ? (double)k * period : INFINITY;
+}
+
+static enum mps_status run(const struct mps_cli *cli, const char *model_name,
+                           struct mps_err *err)
+{
+    double wall_start = mps_wall_seconds();
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const char *const ignore[] = {"fluid.", "coupling.", NULL};
+    struct mps_case *c = NULL;
+    enum mps_status st = mps_case_load(&c, cli->case_path, cli->sets, cli->nsets, tables, 2,
+                                       ignore, err);
+    if (st != MPS_OK)
+        return st;
+    struct run r = {0};
+    char *yaml = NULL;
+    if (!model_name)
+        model_name = mps_case_string(c, "solid.model");
+    r.ops = solid_model_find(model_name);
+    if (!r.ops) {
+        st = mps_err_set(err, MPS_EINPUT, "--model %s: unknown solid model (known: %s)",
+                         model_name, solid_model_names());
+        goto done;
+    }
+    if (!cli->out_dir) {
+        st = mps_err_set(err, MPS_EINPUT, "missing --out DIR (see --help)");
+        goto done;
+    }
+    if ((st = r.ops->create(&r.model, c, err)) != MPS_OK)
+        goto done;
+    if ((st = mps_mkdir_p(cli->out_dir, err)) != MPS_OK)
+        goto done;
+
+    const double end = mps_case_double(c, "end_time");
+    const double out_dt = mps_case_double(c, "output.interval");
+    const double probe_dt = mps_case_double(c, "output.probe_interval");
+    yaml = mps_case_resolved_yaml(c);
+    if (out_dt > 0.0 &&
+        (st = mps_h5_open(&r.h5, cli->out_dir, "solid", "solid_solver", yaml, err)) != MPS_OK)
+        goto done;
+    r.nprobes = r.ops->probe_count(r.model);
+    const char **names = calloc((size_t)r.nprobes + 1, sizeof *names);
+    r.pvals = calloc((size_t)r.nprobes + 1, sizeof *r.pvals);
+    if (!names || !r.pvals) {
+        free(names);
+        st = mps_err_set(err, MPS_ENOMEM, "out of memory");
+        goto done;
+    }
+    for (int k = 0; k < r.nprobes; k++)
+        names[k] = r.ops->probe_name(r.model, k);
+    char path[4096];
+    snprintf(path, sizeof path, "%s/probes.csv", cli->out_dir);
+    st = mps_probes_open(&r.probes, path, names, r.nprobes, err);
+    free(names);
+    if (st != MPS_OK)
+        goto done;
+
+    const double(*x)[MPS_DIM] = NULL;
+    struct mps_field f[MAX_FIELDS];
+    int nf = 0;
+    size_t n = r.ops->snapshot(r.model, &x, f, MAX_FIELDS, &nf);
+    const double dt_stable = r.ops->stable_dt(r.model);
+    if (!cli->quiet)
+        fprintf(stderr, "solid_solver: %s, model %s, %zu particles, dt = %.4g s, %.0f steps\n",
+                mps_case_path(c), r.ops->name, n, dt_stable, ceil(end / dt_stable));
+
+    struct mps_progress prog;
+    mps_progress_init(&prog, "solid", end, cli->quiet);
+    double t = 0.0, wall_loop = 0.0;
+    long step = 0, kout = 0, kprobe = 0;
+    double last_snapshot = -1.0;
+    if (r.h5 && (st = write_snapshot(&r, t, step, err)) != MPS_OK)
+        goto done;
+    last_snapshot = 0.0;
+    if ((st = write_probes(&r, t, err)) != MPS_OK)
+        goto done;
+    kout = kprobe = 1;
+    while (t < end) {
+        double t_out = event(kout, out_dt), t_probe = event(kprobe, probe_dt);
+        double target = fmin(fmin(t_out, t_probe), end);
+        /* Equal steps that land exactly on the next event. */
+        double nsub = ceil((target - t) / dt_stable * (1.0 - 1e-12));
+        if (nsub < 1.0)
+            nsub = 1.0;
+        double dt = (target - t) / nsub;
+        double w0 = mps_wall_seconds();
+        for (long k = 0; k < (long)nsub && st == MPS_OK; k++) {
+            st = r.ops->advance(r.model, dt, err);
+            if ((k & 1023) == 1023)
+                mps_progress_update(&prog, t + (double)(k + 1) * dt, step + k + 1);
+        }
+        wall_loop += mps_wall_seconds() - w0;
+        step += (long)nsub;
+        if (st != MPS_OK)
+            goto done;
+        t = target;
+        if (t >= t_probe) {
+            if ((st = write_probes(&r, t, err)) != MPS_OK)
+                goto done;
+            kprobe++;
+        }
+        if (r.h5 && (t >= t_out || t >= end) && last_snapshot != t) {
+            if ((st = write_snapshot(&r, t, step, err)) != MPS_OK)
+                goto done;
+            last_snapshot = t;
+        }
+        if (t >= t_out)
+            kout++;
+        mps_progress_update(&prog, t, step);
+    }
+    mps_progress_finish(&prog, t, step);
+    st = write_summary(&r, c, cli->out_dir, n, step, t, wall_loop,
+                       mps_wall_seconds() - wall_start, err);
+    if (st == MPS_OK && !cli->quiet)
+        fprintf(stderr, "solid_solver: %ld steps in %.3g s, %.1f ns per particle-step\n", step,
+                wall_loop, step > 0 ? 1e9 * wall_loop / ((double)n * (double)step) : 0.0);
+done:
+    mps_probes_close(&r.probes);
+    mps_h5_close(&r.h5);
+    free(r.pvals);
+    free(yaml);
+    if (r.ops && r.model)
+        r.ops->destroy(&r.model);
+    mps_case_destroy(&c);
+    return st;
+}
+
+static volatile int stop_signal = 0;
+
+static void on_signal(int sig)
+{
+    stop_signal = sig;
+}
+
+/* Under the coupler: solid_solver [--model NAME] --connect ENDPOINT. Without
+ * --model the case's solid.model decides (read when CONFIG arrives). */
+static int run_coupled(int argc, char **argv, const char *endpoint, int hello_ms)
+{
+    const struct solid_model_ops *ops = NULL;
+    for (int i = 1; i + 1 < argc; i++)
+        if (strcmp(argv[i], "--model") == 0 && !(ops = solid_model_find(argv[i + 1]))) {
+            fprintf(stderr, "solid_solver: --model %s: unknown model (known: %s)\n", argv[i + 1],
+                    solid_model_names());
+            return 2;
+        }
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    return solid_peer_run(endpoint, ops, hello_ms, &stop_signal);
+}
+
+int main(int argc, char **argv)
+{
+    struct mps_cli cli;
+    struct mps_err err = {0};
+    const char *endpoint = NULL;
+    int hello_ms = 0, coupled = proto_solver_args(argc, argv, &endpoint, &hello_ms, &err);
+    if (coupled < 0) {
+        fprintf(stderr, "solid_solver: %s\n", err.msg);
+        return 2;
+    }
+    if (coupled)
+        return run_coupled(argc, argv, endpoint, hello_ms);
+    struct mps_cli_extra extra[] = {
+        {"--model", 1, "solid model (default: the case's solid.model)", NULL},
+    };
+    enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
+    if (st == MPS_EINTR)
+        return 0; /* --help */
+    if (st == MPS_OK)
+        st = run(&cli, extra[0].value, &err);
+    if (st != MPS_OK)
+        fprintf(stderr, "solid_solver: %s\n", err.msg);
+    return mps_status_exit_code(st);
+}

@@ -1,0 +1,144 @@
+#!/usr/bin/python3
+"""A third-party solid: an elastic plate as a cantilever beam in its first
+bending mode, written in Python against proto/PROTOCOL.md only (numpy, pyzmq,
+PyYAML from Debian; the wire codec is proto/python/mpsproto.py, itself written
+from PROTOCOL.md). It proves a solver in another language can replace ours.
+
+Model (Euler-Bernoulli, per metre depth): the first body of the case is a
+vertical plate of thickness b = x1 - x0 clamped where a solid.clamps region
+covers it (its top edge is the root); above the root, the lateral displacement
+is u(s, t) = q(t) phi(s), s the height above the root, phi the first cantilever
+mode normalised to phi(L) = 1. Then M q'' + K q = F with M = rho b int phi^2,
+K = E b^3/12 int phi''^2 (= omega_1^2 M) and F = sum_k f_x,k phi(s_k), the
+generalised force of the fluid loads. q is the tip deflection (probe tip_dx).
+
+usage: modal_beam_solid.py [--courant C] --connect ENDPOINT
+"""
+import json, math, os, sys, time
+
+import numpy as np
+import yaml
+import zmq
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'proto',
+                                'python'))
+import mpsproto as mp  # noqa: E402
+
+BETA_L = 1.8751040687119611  # first root of cos(x) cosh(x) = -1
+
+
+def mode(s, L):
+    """First cantilever mode and its second derivative, phi(L) = 1."""
+    b = BETA_L / L
+    sig = (math.cosh(BETA_L) + math.cos(BETA_L)) / (math.sinh(BETA_L) + math.sin(BETA_L))
+    def raw(x):
+        return np.cosh(b * x) - np.cos(b * x) - sig * (np.sinh(b * x) - np.sin(b * x))
+    def raw2(x):
+        return b * b * (np.cosh(b * x) + np.cos(b * x) - sig * (np.sinh(b * x) + np.sin(b * x)))
+    tip = raw(L)
+    s = np.clip(s, 0.0, L)
+    return raw(s) / tip, raw2(s) / tip
+
+
+class Beam:
+    def __init__(self, case, courant):
+        dp = float(case['dp'])
+        body = case['solid']['bodies'][0]
+        x0, y0, x1, y1 = (float(body[k]) for k in ('x0', 'y0', 'x1', 'y1'))
+        rho, E = float(body['rho']), float(body['E'])
+        clamps = case['solid'].get('clamps', [])
+        root = max([float(c['y1']) for c in clamps] + [y0])
+        nx, ny = int(math.floor((x1 - x0) / dp + 1e-6)), int(math.floor((y1 - y0) / dp + 1e-6))
+        ii, jj = np.meshgrid(np.arange(nx), np.arange(ny))
+        self.x0 = np.column_stack([x0 + (ii.ravel() + 0.5) * dp, y0 + (jj.ravel() + 0.5) * dp])
+        self.n = len(self.x0)
+        self.id = np.arange(self.n, dtype=np.int32)
+        self.fixed = (self.x0[:, 1] < root).astype(np.uint8)
+        edge = (ii.ravel() == 0) | (ii.ravel() == nx - 1) | (jj.ravel() == 0) | (jj.ravel() == ny - 1)
+        self.surface = edge.astype(np.uint8)
+        self.L = y1 - root
+        b = x1 - x0
+        s = np.linspace(0.0, self.L, 2001)
+        phi, phi2 = mode(s, self.L)
+        self.M = rho * b * np.trapz(phi ** 2, s)
+        self.K = E * b ** 3 / 12.0 * np.trapz(phi2 ** 2, s)
+        self.omega = math.sqrt(self.K / self.M)
+        self.phi, _ = mode(self.x0[:, 1] - root, self.L)
+        self.phi[self.fixed == 1] = 0.0
+        self.dt = courant * 2.0 / self.omega / 10.0  # well inside the symplectic limit 2/omega
+        self.q = self.qd = 0.0
+        self.force = 0.0
+
+    def state(self):
+        x = self.x0.copy()
+        x[:, 0] += self.q * self.phi
+        v = np.zeros_like(x)
+        v[:, 0] = self.qd * self.phi
+        return x, v
+
+    def advance(self, h, n):
+        for _ in range(n):  # symplectic Euler, as the MPS solid
+            self.qd += h * (self.force - self.K * self.q) / self.M
+            self.q += h * self.qd
+
+
+def main():
+    args = sys.argv[1:]
+    endpoint = args[args.index('--connect') + 1]
+    courant = float(args[args.index('--courant') + 1]) if '--courant' in args else 0.5
+    t_wall = time.time()
+    compute = 0.0
+    ctx = zmq.Context()
+    sock = mp.connect(ctx, endpoint)
+    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
+    cfg = mp.recv(sock, 60000)
+    if cfg.type == mp.Type.REJECT:
+        print(f'modal_beam_solid: refused: {cfg.text}', file=sys.stderr)
+        return 1
+    conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
+    with open(conf['case']) as f:
+        case = yaml.safe_load(f)
+    beam = Beam(case, courant)
+    timeout = int(conf.get('timeout_ms', '1800000'))
+    step = 0
+
+    def state_msg(mtype, **kw):
+        x, v = beam.state()
+        return mp.Message(mtype, payload=mp.Payload.STATE, id=beam.id, x=x, v=v,
+                          surface=beam.surface, fixed=beam.fixed, dt=beam.dt, **kw)
+
+    mp.send(sock, state_msg(mp.Type.READY, text='tip_dx'))
+    while True:
+        m = mp.recv(sock, timeout)
+        if m.type == mp.Type.STOP:
+            summary = {'solver': 'modal_beam_solid', 'model': 'modal_beam', 'status': 'ok',
+                       'compute_seconds': compute, 'wall_seconds': time.time() - t_wall,
+                       'omega_1': beam.omega, 'f_1_hz': beam.omega / (2 * math.pi),
+                       'coupling_steps': step}
+            mp.send(sock, mp.Message(mp.Type.BYE, step=m.step, time=m.time, text=json.dumps(summary)))
+            break
+        if m.type == mp.Type.ABORT:
+            return 1
+        if m.type != mp.Type.ADVANCE:
+            mp.send(sock, mp.Message(mp.Type.ERROR, text=f'protocol: unexpected {m.type}'))
+            return 1
+        c0 = time.time()
+        beam.force = 0.0
+        if m.payload == mp.Payload.LOADS and m.count:
+            idx = m.id.astype(np.int64)
+            beam.force = float(np.sum(m.force[:, 0] * beam.phi[idx]))
+        beam.advance(m.dt / m.n_sub, m.n_sub)
+        step += 1
+        kw = {}
+        if m.flags & mp.F_PROBES:
+            kw = dict(flags=mp.F_PROBES, probes=np.array([beam.q]))
+        res = state_msg(mp.Type.RESULT, step=m.step, iteration=m.iteration, time=m.time + m.dt, **kw)
+        compute += time.time() - c0
+        mp.send(sock, res)
+    sock.close()
+    ctx.term()
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())

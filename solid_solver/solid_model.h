@@ -1,0 +1,69 @@
+/* The contract every solid model honours (MPS solid, TLSPH solid, ...), so the
+ * solid program and the coupling loop never depend on a model's insides.
+ * A model owns its particles; the caller borrows views of them. Units SI;
+ * in 2D forces are per metre of depth. */
+#ifndef SOLID_MODEL_H
+#define SOLID_MODEL_H
+
+#include <stddef.h>
+
+#include "mps_case.h"
+#include "mps_dim.h"
+#include "mps_err.h"
+#include "mps_h5.h"
+#include "mps_json.h"
+
+/* What a coupled fluid needs of the solid: the surface particles (they take
+ * part in the fluid's pressure Poisson equation and receive loads) and the
+ * inner particles within `depth` of the surface (they only fill the fluid's
+ * particle number density, like dummy wall particles). Arrays are borrowed and
+ * stay valid until the next call into the model. */
+struct solid_iface {
+    size_t n;
+    const int *id;                  /* stable particle ids (index at creation) */
+    const double (*x)[MPS_DIM];     /* m */
+    const double (*v)[MPS_DIM];     /* m/s */
+    const unsigned char *surface;   /* 1 surface, 0 inner near-surface */
+    const unsigned char *fixed;     /* 1 clamped (never moves) */
+};
+
+/* Fluid loads on surface particles, held constant over the sub-steps of one
+ * fluid step. force: total fluid force on the particle (N, per metre depth in
+ * 2D), i.e. Eq. 50's force density times the particle volume. */
+struct solid_loads {
+    size_t n;
+    const int *id;
+    const double *pressure;         /* Pa, for output */
+    const double (*force)[MPS_DIM];
+};
+
+struct solid_model_ops {
+    const char *name;   /* "mps", "tlsph" */
+    /* Builds the bodies from the case (keys under "solid."). */
+    enum mps_status (*create)(void **self, const struct mps_case *c, struct mps_err *err);
+    /* Largest stable explicit step now (s), Courant number included. */
+    double (*stable_dt)(const void *self);
+    /* Replaces the fluid loads (ids not present get zero load). */
+    enum mps_status (*set_loads)(void *self, const struct solid_loads *f, struct mps_err *err);
+    /* One explicit step of dt <= stable_dt. Reports MPS_EDIVERGED on NaN. */
+    enum mps_status (*advance)(void *self, double dt, struct mps_err *err);
+    enum mps_status (*interface)(void *self, double depth, struct solid_iface *out,
+                                 struct mps_err *err);
+    /* Case probes ("solid.probes.*"): names and current values. */
+    int (*probe_count)(const void *self);
+    const char *(*probe_name)(const void *self, int k);
+    double (*probe_value)(const void *self, int k);
+    /* Particle positions and output fields for a snapshot (borrowed). */
+    size_t (*snapshot)(void *self, const double (**x)[MPS_DIM], struct mps_field *fields,
+                       int max_fields, int *nfields);
+    /* Extra summary members (phase times, counters) into an open JSON object. */
+    void (*summary)(const void *self, struct mps_json *j);
+    void (*destroy)(void **self);
+};
+
+/* The models compiled in, by name; NULL if unknown. */
+const struct solid_model_ops *solid_model_find(const char *name);
+/* "mps, tlsph": for error messages. */
+const char *solid_model_names(void);
+
+#endif

@@ -1,0 +1,633 @@
+#include "solid_mps.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mps_kernel.h"
+#include "mps_nbr.h"
+
+/* Below this many particles a step is too short for threads to pay off. */
+#define SOLID_MPS_OMP_MIN 4096
+
+static const char *const phase_names[SOLID_PH_N] = {"strain", "force", "update"};
+
+static void register_fields(struct solid_mps *s)
+{
+    struct mps_particles *ps = &s->ps;
+    mps_particles_init(ps);
+    /* hot: read every step */
+    mps_particles_add_field(ps, "x", MPS_DIM, MPS_F64, (void **)&s->x, "m", 0);
+    mps_particles_add_field(ps, "velocity", MPS_DIM, MPS_F64, (void **)&s->v, "m/s", 1);
+    mps_particles_add_field(ps, "theta", 1, MPS_F64, (void **)&s->theta, "rad", 1);
+    mps_particles_add_field(ps, "omega", 1, MPS_F64, (void **)&s->omega, "rad/s", 1);
+    mps_particles_add_field(ps, "hc", 1, MPS_F64, (void **)&s->hc, "", 0);
+    mps_particles_add_field(ps, "hs", 1, MPS_F64, (void **)&s->hs, "", 0);
+    mps_particles_add_field(ps, "kq", 1, MPS_F64, (void **)&s->kq, "", 0);
+    mps_particles_add_field(ps, "q", 1, MPS_F64, (void **)&s->q, "", 0);
+    mps_particles_add_field(ps, "load_acceleration", MPS_DIM, MPS_F64, (void **)&s->aload,
+                            "m/s^2", 1); /* fluid load / (rho dp^2) */
+    mps_particles_add_field(ps, "fixed", 1, MPS_U8, (void **)&s->fixed, "", 1);
+    /* cold */
+    mps_particles_add_field(ps, "x0", MPS_DIM, MPS_F64, (void **)&s->x0, "m", 0);
+    mps_particles_add_field(ps, "displacement", MPS_DIM, MPS_F64, (void **)&s->disp, "m", 1);
+    mps_particles_add_field(ps, "pressure", 1, MPS_F64, (void **)&s->pressure, "Pa", 1);
+    mps_particles_add_field(ps, "n0", 1, MPS_F64, (void **)&s->n0, "", 0);
+    mps_particles_add_field(ps, "id", 1, MPS_I32, (void **)&s->id, "", 1);
+    mps_particles_add_field(ps, "body", 1, MPS_I32, (void **)&s->body, "", 1);
+    mps_particles_add_field(ps, "surface", 1, MPS_U8, (void **)&s->surface, "", 1);
+}
+
+/* Fills the lattices: each body column by column if it is wider than tall
+ * (row by row otherwise), so bonded particles are close in memory. */
+static void fill_bodies(struct solid_mps *s)
+{
+    const struct solid_scene *sc = &s->scene;
+    size_t k = 0;
+    for (int b = 0; b < sc->nbodies; b++) {
+        const struct solid_body_def *d = &sc->bodies[b];
+        long nx, ny;
+        solid_scene_lattice(sc, b, &nx, &ny);
+        int cols = nx >= ny;
+        long na = cols ? nx : ny, nb = cols ? ny : nx;
+        for (long a = 0; a < na; a++)
+            for (long c = 0; c < nb; c++, k++) {
+                long i = cols ? a : c, j = cols ? c : a;
+                s->x[k][0] = s->x0[k][0] = d->x0 + s->dp * (0.5 + (double)i);
+                s->x[k][1] = s->x0[k][1] = d->y0 + s->dp * (0.5 + (double)j);
+                s->v[k][0] = d->v[0];
+                s->v[k][1] = d->v[1];
+                s->hc[k] = 1.0;
+                s->body[k] = b;
+                s->id[k] = (int)k;
+            }
+    }
+    for (int c = 0; c < sc->nclamps; c++) {
+        const struct solid_clamp_def *d = &sc->clamps[c];
+        for (size_t i = 0; i < s->n; i++)
+            if (s->body[i] == d->body && s->x0[i][0] >= d->x0 && s->x0[i][0] <= d->x1 &&
+                s->x0[i][1] >= d->y0 && s->x0[i][1] <= d->y1) {
+                s->fixed[i] = 1;
+                s->v[i][0] = s->v[i][1] = 0.0;
+            }
+    }
+    s->nfree = 0;
+    for (size_t i = 0; i < s->n; i++)
+        s->nfree += !s->fixed[i];
+}
+
+/* Eq. 15's correction matrix, used as a per-bond weight: a_ij = e^T B_i^-1 e
+ * with B_i = sum_k w_ik e_ik e_ik^T over the initial bonds (e = r0/|r0|).
+ * Inside the lattice B = n0/d I, so a_ij = d/n0, the paper's factor; at a
+ * surface it weights the bonds along the surface by what the particle really
+ * has in that direction, where d/n0_i would also count the missing bonds
+ * across it (see solid_mps.h). Falls back to d/n0_i when B is singular. */
+static void bond_weights(const struct solid_mps *s, size_t i, double *a)
+{
+    double bxx = 0.0, bxy = 0.0, byy = 0.0;
+    for (size_t b = s->bstart[i]; b < s->bstart[i + 1]; b++) {
+        double il = 1.0 / s->blen[b], ex = s->br0[b][0] * il, ey = s->br0[b][1] * il;
+        double w = mps_weight(s->blen[b], SOLID_MPS_RE * s->dp);
+        bxx += w * ex * ex;
+        bxy += w * ex * ey;
+        byy += w * ey * ey;
+    }
+    double det = bxx * byy - bxy * bxy, tr = bxx + byy;
+    for (size_t b = s->bstart[i]; b < s->bstart[i + 1]; b++) {
+        double il = 1.0 / s->blen[b], ex = s->br0[b][0] * il, ey = s->br0[b][1] * il;
+        if (det > 1e-6 * tr * tr)
+            a[b - s->bstart[i]] = (byy * ex * ex - 2.0 * bxy * ex * ey + bxx * ey * ey) / det;
+        else
+            a[b - s->bstart[i]] = MPS_DIM / s->n0[i];
+    }
+}
+
+/* Bonds to the initial neighbours of the same body within re (Eq. 7), with
+ * the per-bond constants folded once (fixed bonds: no search per step). */
+static enum mps_status build_bonds(struct solid_mps *s, struct mps_err *err)
+{
+    const double re = SOLID_MPS_RE * s->dp;
+    struct mps_nbr_grid g = {0};
+    struct mps_nbr_list l = {0};
+    double *a = NULL;
+    enum mps_status st = mps_nbr_grid_build(&g, s->n, (const double(*)[MPS_DIM])s->x0, re, err);
+    if (st == MPS_OK)
+        st = mps_nbr_list_build(&l, &g, (const double(*)[MPS_DIM])s->x0, s->n, re, err);
+    if (st != MPS_OK)
+        goto done;
+    s->bstart = malloc((s->n + 1) * sizeof *s->bstart);
+    size_t nb = 0, most = 0;
+    if (s->bstart)
+        for (size_t i = 0; i < s->n; i++) {
+            s->bstart[i] = nb;
+            for (size_t e = l.start[i]; e < l.start[i + 1]; e++)
+                nb += s->body[l.j[e]] == s->body[i];
+            if (nb - s->bstart[i] > most)
+                most = nb - s->bstart[i];
+        }
+    s->nbonds = nb;
+    s->bj = malloc((nb + 1) * sizeof *s->bj);
+    s->br0 = malloc((nb + 1) * sizeof *s->br0);
+    s->blen = malloc((nb + 1) * sizeof *s->blen);
+    s->bk = malloc((nb + 1) * sizeof *s->bk);
+    s->bb = malloc((nb + 1) * sizeof *s->bb);
+    s->bbr = malloc((nb + 1) * sizeof *s->bbr);
+    a = malloc((nb + 1) * sizeof *a);
+    if (!s->bstart || !s->bj || !s->br0 || !s->blen || !s->bk || !s->bb || !s->bbr || !a) {
+        st = mps_err_set(err, MPS_ENOMEM, "solid: no memory for %zu bonds", nb);
+        goto done;
+    }
+    s->bstart[s->n] = nb;
+    for (size_t i = 0; i < s->n; i++) {
+        size_t b = s->bstart[i];
+        s->n0[i] = 0.0;
+        for (size_t e = l.start[i]; e < l.start[i + 1]; e++) {
+            int j = l.j[e];
+            if (s->body[j] != s->body[i])
+                continue;
+            s->bj[b] = j;
+            s->br0[b][0] = s->x0[j][0] - s->x0[i][0];
+            s->br0[b][1] = s->x0[j][1] - s->x0[i][1];
+            s->blen[b] = sqrt(l.r2[e]);
+            s->n0[i] += mps_weight(s->blen[b], re); /* Eq. 8 on the initial lattice */
+            b++;
+        }
+    }
+    for (size_t i = 0; i < s->n; i++) {
+        bond_weights(s, i, a + s->bstart[i]);
+        s->surface[i] = s->n0[i] < s->n0_lattice - SOLID_MPS_NC; /* Eq. 48 */
+    }
+    for (size_t i = 0; i < s->n; i++) {
+        const struct solid_mps_material *m = &s->mat[s->body[i]];
+        s->kq[i] = -m->lambda / m->rho;
+        for (size_t b = s->bstart[i]; b < s->bstart[i + 1]; b++) {
+            int j = s->bj[b];
+            size_t r = s->bstart[j]; /* the same bond seen from j */
+            while (s->bj[r] != (int)i)
+                r++;
+            double w = mps_weight(s->blen[b], re), len = s->blen[b];
+            s->bb[b] = a[b] * w / len;  /* Eq. 30 */
+            s->bbr[b] = a[r] * w / len;
+            /* Eq. 36-37 with 2d/n0 as the pair sum a_ij + a_ji: k_ij = k_ji. */
+            s->bk[b] = (2.0 * m->mu / m->rho) * (a[b] + a[r]) * w / (len * len);
+        }
+    }
+    /* Spin frequency bound (Gershgorin on the spin block): the spins of i and
+     * its neighbours in phase give I w^2 = 1/2 sum m k |r0|^2 (Eq. 43-44). */
+    s->spin_omega = 0.0;
+    for (size_t i = 0; i < s->n; i++) {
+        double sum = 0.0;
+        for (size_t b = s->bstart[i]; b < s->bstart[i + 1]; b++)
+            sum += s->bk[b] * s->blen[b] * s->blen[b];
+        s->spin_omega = fmax(s->spin_omega, sqrt(3.0 * sum) / s->dp);
+    }
+done:
+    free(a);
+    mps_nbr_list_free(&l);
+    mps_nbr_grid_free(&g);
+    return st;
+}
+
+/* Probe k averages the particles nearest its point (ties: a tip probe between
+ * two rows takes the mean of both). */
+static void find_probes(struct solid_mps *s)
+{
+    s->nprobes = s->scene.nprobes;
+    for (int k = 0; k < s->nprobes; k++) {
+        const struct solid_probe_def *p = &s->scene.probes[k];
+        double best = INFINITY;
+        for (size_t i = 0; i < s->n; i++)
+            best = fmin(best, hypot(s->x0[i][0] - p->x, s->x0[i][1] - p->y));
+        s->probe_n[k] = 0;
+        for (size_t i = 0; i < s->n && s->probe_n[k] < SOLID_MPS_PROBE_MAX; i++)
+            if (hypot(s->x0[i][0] - p->x, s->x0[i][1] - p->y) <= best + 1e-6 * s->dp)
+                s->probe_i[k][s->probe_n[k]++] = i;
+    }
+}
+
+enum mps_status solid_mps_create(struct solid_mps **out, const struct solid_scene *scene,
+                                 struct mps_err *err)
+{
+    *out = NULL;
+    struct solid_mps *s = calloc(1, sizeof *s);
+    if (!s)
+        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+    s->scene = *scene;
+    s->dp = scene->dp;
+    s->courant = scene->courant;
+    s->n0_lattice = mps_lattice_consts(s->dp, SOLID_MPS_RE * s->dp).n0;
+    s->iface_depth = -1.0;
+    size_t n = 0;
+    for (int b = 0; b < scene->nbodies; b++) {
+        struct solid_mps_material *m = &s->mat[b];
+        m->rho = scene->bodies[b].rho;
+        m->E = scene->bodies[b].E;
+        m->nu = scene->bodies[b].nu;
+        solid_scene_lame(scene, b, &m->lambda, &m->mu);
+        m->wave_speed = sqrt((m->lambda + 2.0 * m->mu) / m->rho);
+        long nx, ny;
+        solid_scene_lattice(scene, b, &nx, &ny);
+        n += (size_t)nx * (size_t)ny;
+    }
+    register_fields(s);
+    enum mps_status st = mps_particles_resize(&s->ps, n, err);
+    if (st == MPS_OK) {
+        s->n = n;
+        fill_bodies(s);
+        st = build_bonds(s, err);
+    }
+    if (st != MPS_OK) {
+        solid_mps_destroy(&s);
+        return st;
+    }
+    find_probes(s);
+    mps_timer_init(&s->timer, phase_names, SOLID_PH_N);
+    *out = s;
+    return MPS_OK;
+}
+
+void solid_mps_destroy(struct solid_mps **sp)
+{
+    if (!sp || !*sp)
+        return;
+    struct solid_mps *s = *sp;
+    mps_particles_free(&s->ps);
+    free(s->bstart);
+    free(s->bj);
+    free(s->br0);
+    free(s->blen);
+    free(s->bk);
+    free(s->bb);
+    free(s->bbr);
+    free(s->iface_idx);
+    free(s->iface_id);
+    free(s->iface_x);
+    free(s->iface_v);
+    free(s->iface_surface);
+    free(s->iface_fixed);
+    free(s);
+    *sp = NULL;
+}
+
+double solid_mps_stable_dt(const struct solid_mps *s)
+{
+    double c = 0.0;
+    for (int b = 0; b < s->scene.nbodies; b++)
+        c = fmax(c, s->mat[b].wave_speed);
+    double dt_wave = c > 0.0 ? s->dp / c : INFINITY;
+    double dt_spin = s->spin_omega > 0.0 ? 2.0 / s->spin_omega : INFINITY;
+    return s->courant * fmin(dt_wave, dt_spin);
+}
+
+/* Eq. 25: u_ij = r_ij - R(theta_ij) r0_ij with theta_ij the mean rotation; cos
+ * and sin of the mean come from the half angles, so no trigonometry per bond. */
+#define BOND_U(i, b)                                                          \
+    int j = bj[b];                                                            \
+    double C = ci * hc[j] - si * hs[j], S = si * hc[j] + ci * hs[j];          \
+    double rx = x[j][0] - xi, ry = x[j][1] - yi;                              \
+    double ux = rx - (C * br0[b][0] - S * br0[b][1]);                         \
+    double uy = ry - (S * br0[b][0] + C * br0[b][1]);                         \
+    double r = sqrt(rx * rx + ry * ry)
+
+/* Volumetric strain pass (Eq. 30, 33): q_i = p_i / rho = -(lambda/rho) tr_i,
+ * tr_i = sum_j beta_ij (|r_ij| - |r0_ij|), the bond stretch standing for
+ * u_ij . r_ij / |r_ij| (equal to first order, and without the spurious
+ * second-order dilatation of a sheared bond; its exact gradient is the
+ * pressure force, so the update conserves energy). */
+static void strain_pass(struct solid_mps *s)
+{
+    const size_t n = s->n;
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])s->x;
+    const double *bb = s->bb, *blen = s->blen, *kq = s->kq;
+    const size_t *bstart = s->bstart;
+    const int *bj = s->bj;
+    double *q = s->q;
+#pragma omp parallel for schedule(static) if (n >= SOLID_MPS_OMP_MIN)
+    for (size_t i = 0; i < n; i++) {
+        double xi = x[i][0], yi = x[i][1], sum = 0.0;
+        for (size_t b = bstart[i]; b < bstart[i + 1]; b++) {
+            int j = bj[b];
+            double rx = x[j][0] - xi, ry = x[j][1] - yi;
+            sum += bb[b] * (sqrt(rx * rx + ry * ry) - blen[b]);
+        }
+        q[i] = kq[i] * sum;
+    }
+}
+
+enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err *err)
+{
+    const size_t n = s->n;
+    double(*x)[MPS_DIM] = s->x;
+    double(*v)[MPS_DIM] = s->v;
+    const double *hc = s->hc, *hs = s->hs, *bk = s->bk, *bb = s->bb, *bbr = s->bbr;
+    const double *q = s->q;
+    const double(*br0)[MPS_DIM] = (const double(*)[MPS_DIM])s->br0;
+    const double(*aload)[MPS_DIM] = (const double(*)[MPS_DIM])s->aload;
+    const size_t *bstart = s->bstart;
+    const int *bj = s->bj;
+    const unsigned char *fixed = s->fixed;
+    double *omega = s->omega, *theta = s->theta;
+    const double gx = s->scene.g[0], gy = s->scene.g[1];
+    const double spin = 3.0 / (s->dp * s->dp); /* rho V / (2 I), Eq. 43-44 */
+
+    mps_timer_switch(&s->timer, SOLID_PH_STRAIN);
+    strain_pass(s);
+
+    mps_timer_switch(&s->timer, SOLID_PH_FORCE);
+#pragma omp parallel for schedule(static) if (n >= SOLID_MPS_OMP_MIN)
+    for (size_t i = 0; i < n; i++) {
+        if (fixed[i])
+            continue;
+        double xi = x[i][0], yi = x[i][1], ci = hc[i], si = hs[i], qi = q[i];
+        double ax = 0.0, ay = 0.0, tq = 0.0;
+        for (size_t b = bstart[i]; b < bstart[i + 1]; b++) {
+            BOND_U(i, b);
+            /* Eq. 36-37 (normal + shear stress) and Eq. 38 as -grad p; one add
+             * per bond into each sum keeps the dependency chains short. */
+            double k = bk[b], f = (qi * bb[b] + q[j] * bbr[b]) / r;
+            ax += k * ux - f * rx;
+            ay += k * uy - f * ry;
+            tq += k * (rx * uy - ry * ux); /* Eq. 41-43 */
+        }
+        v[i][0] += dt * (ax + gx + aload[i][0]); /* Eq. 39 */
+        v[i][1] += dt * (ay + gy + aload[i][1]);
+        omega[i] += dt * spin * tq; /* Eq. 45 */
+    }
+
+    mps_timer_switch(&s->timer, SOLID_PH_UPDATE);
+    double *hcw = s->hc, *hsw = s->hs;
+    long bad = 0;
+#pragma omp parallel for schedule(static) if (n >= SOLID_MPS_OMP_MIN) reduction(+ : bad)
+    for (size_t i = 0; i < n; i++) {
+        if (fixed[i])
+            continue;
+        x[i][0] += dt * v[i][0]; /* Eq. 40 */
+        x[i][1] += dt * v[i][1];
+        theta[i] += dt * omega[i]; /* Eq. 46 */
+        hcw[i] = cos(0.5 * theta[i]);
+        hsw[i] = sin(0.5 * theta[i]);
+        bad += !isfinite(x[i][0] + x[i][1] + theta[i]);
+    }
+    mps_timer_stop(&s->timer);
+    s->time += dt;
+    s->steps++;
+    if (bad) {
+        size_t i = 0;
+        while (i < n && isfinite(x[i][0] + x[i][1] + theta[i]))
+            i++;
+        return mps_err_set(err, MPS_EDIVERGED,
+                           "solid: particle %zu (body '%s') has a non-finite state at t = %g s "
+                           "(step %ld, dt = %g s): the step is above the stability limit or "
+                           "the loads are unphysical",
+                           i, s->scene.bodies[s->body[i]].name, s->time, s->steps, dt);
+    }
+    return MPS_OK;
+}
+
+void solid_mps_diag(const struct solid_mps *s, struct solid_mps_diag *dg)
+{
+    memset(dg, 0, sizeof *dg);
+    const double V = s->dp * s->dp;
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])s->x;
+    const double *hc = s->hc, *hs = s->hs;
+    const double(*br0)[MPS_DIM] = (const double(*)[MPS_DIM])s->br0;
+    const int *bj = s->bj;
+    for (size_t i = 0; i < s->n; i++) {
+        const struct solid_mps_material *m = &s->mat[s->body[i]];
+        double mass = m->rho * V, inertia = mass * s->dp * s->dp / 6.0; /* Eq. 44 */
+        const double *vi = s->v[i];
+        dg->momentum[0] += mass * vi[0];
+        dg->momentum[1] += mass * vi[1];
+        dg->angular += mass * (x[i][0] * vi[1] - x[i][1] * vi[0]) + inertia * s->omega[i];
+        dg->kinetic += 0.5 * mass * (vi[0] * vi[0] + vi[1] * vi[1]) +
+                       0.5 * inertia * s->omega[i] * s->omega[i];
+        dg->gravity -= mass * (s->scene.g[0] * x[i][0] + s->scene.g[1] * x[i][1]);
+        double xi = x[i][0], yi = x[i][1], ci = hc[i], si = hs[i], tr = 0.0;
+        for (size_t b = s->bstart[i]; b < s->bstart[i + 1]; b++) {
+            BOND_U(i, b);
+            tr += s->bb[b] * (r - s->blen[b]);
+            /* each bond is seen from both ends: 1/2 of 1/2 k |u|^2 */
+            dg->elastic += 0.25 * mass * s->bk[b] * (ux * ux + uy * uy);
+        }
+        dg->elastic += 0.5 * m->lambda * tr * tr * V;
+    }
+}
+
+double solid_mps_probe(const struct solid_mps *s, int k)
+{
+    const struct solid_probe_def *p = &s->scene.probes[k];
+    double sum = 0.0;
+    for (int a = 0; a < s->probe_n[k]; a++) {
+        size_t i = s->probe_i[k][a];
+        switch (p->kind) {
+        case SOLID_PROBE_DX: sum += s->x[i][0] - s->x0[i][0]; break;
+        case SOLID_PROBE_DY: sum += s->x[i][1] - s->x0[i][1]; break;
+        case SOLID_PROBE_X: sum += s->x[i][0]; break;
+        case SOLID_PROBE_Y: sum += s->x[i][1]; break;
+        }
+    }
+    return s->probe_n[k] ? sum / s->probe_n[k] : NAN;
+}
+
+/* ---- solid_model_ops ---- */
+
+static enum mps_status op_create(void **self, const struct mps_case *c, struct mps_err *err)
+{
+    struct solid_scene *sc = malloc(sizeof *sc);
+    if (!sc)
+        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+    enum mps_status st = solid_scene_read(sc, c, err);
+    struct solid_mps *s = NULL;
+    if (st == MPS_OK)
+        st = solid_mps_create(&s, sc, err);
+    free(sc);
+    *self = s;
+    return st;
+}
+
+static double op_stable_dt(const void *self)
+{
+    return solid_mps_stable_dt(self);
+}
+
+static enum mps_status op_set_loads(void *self, const struct solid_loads *f, struct mps_err *err)
+{
+    struct solid_mps *s = self;
+    memset(s->aload, 0, s->n * sizeof *s->aload);
+    for (size_t k = 0; f && k < f->n; k++) {
+        int i = f->id[k];
+        if (i < 0 || (size_t)i >= s->n)
+            return mps_err_set(err, MPS_EINPUT, "solid: load on unknown particle id %d "
+                               "(ids are 0..%zu)", i, s->n - 1);
+        double m = s->mat[s->body[i]].rho * s->dp * s->dp; /* V = dp^2 per metre depth */
+        for (int a = 0; a < MPS_DIM; a++)
+            s->aload[i][a] = f->force[k][a] / m;
+    }
+    return MPS_OK;
+}
+
+static enum mps_status op_advance(void *self, double dt, struct mps_err *err)
+{
+    return solid_mps_advance(self, dt, err);
+}
+
+/* Surface particles (Eq. 48) and the particles within depth of one, found
+ * once per depth on the initial lattice (bonds never change the topology). */
+static enum mps_status build_iface(struct solid_mps *s, double depth, struct mps_err *err)
+{
+    unsigned char *keep = calloc(s->n + 1, 1);
+    if (!keep)
+        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+    enum mps_status st = MPS_OK;
+    for (size_t i = 0; i < s->n; i++)
+        keep[i] = s->surface[i];
+    if (depth > 0.0) {
+        struct mps_nbr_grid g = {0};
+        struct mps_nbr_list l = {0};
+        double rad = depth * (1.0 + 1e-9);
+        st = mps_nbr_grid_build(&g, s->n, (const double(*)[MPS_DIM])s->x0, rad, err);
+        if (st == MPS_OK)
+            st = mps_nbr_list_build(&l, &g, (const double(*)[MPS_DIM])s->x0, s->n, rad, err);
+        for (size_t i = 0; st == MPS_OK && i < s->n; i++)
+            for (size_t e = l.start[i]; !keep[i] && e < l.start[i + 1]; e++)
+                keep[i] = s->surface[l.j[e]] ? 2 : 0;
+        mps_nbr_list_free(&l);
+        mps_nbr_grid_free(&g);
+    }
+    size_t m = 0;
+    for (size_t i = 0; i < s->n; i++)
+        m += keep[i] != 0;
+    free(s->iface_idx);
+    free(s->iface_id);
+    free(s->iface_x);
+    free(s->iface_v);
+    free(s->iface_surface);
+    free(s->iface_fixed);
+    s->iface_idx = malloc((m + 1) * sizeof *s->iface_idx);
+    s->iface_id = malloc((m + 1) * sizeof *s->iface_id);
+    s->iface_x = malloc((m + 1) * sizeof *s->iface_x);
+    s->iface_v = malloc((m + 1) * sizeof *s->iface_v);
+    s->iface_surface = malloc(m + 1);
+    s->iface_fixed = malloc(m + 1);
+    if (st == MPS_OK && (!s->iface_idx || !s->iface_id || !s->iface_x || !s->iface_v ||
+                         !s->iface_surface || !s->iface_fixed))
+        st = mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+    if (st == MPS_OK) {
+        m = 0;
+        for (size_t i = 0; i < s->n; i++)
+            if (keep[i]) {
+                s->iface_idx[m] = i;
+                s->iface_id[m] = s->id[i];
+                s->iface_surface[m] = keep[i] == 1;
+                s->iface_fixed[m] = s->fixed[i];
+                m++;
+            }
+        s->iface_n = m;
+        s->iface_depth = depth;
+    } else {
+        s->iface_n = 0;
+        s->iface_depth = -1.0;
+    }
+    free(keep);
+    return st;
+}
+
+static enum mps_status op_interface(void *self, double depth, struct solid_iface *out,
+                                    struct mps_err *err)
+{
+    struct solid_mps *s = self;
+    if (depth != s->iface_depth) {
+        enum mps_status st = build_iface(s, depth, err);
+        if (st != MPS_OK)
+            return st;
+    }
+    for (size_t k = 0; k < s->iface_n; k++) {
+        size_t i = s->iface_idx[k];
+        for (int a = 0; a < MPS_DIM; a++) {
+            s->iface_x[k][a] = s->x[i][a];
+            s->iface_v[k][a] = s->v[i][a];
+        }
+    }
+    *out = (struct solid_iface){s->iface_n, s->iface_id, (const double(*)[MPS_DIM])s->iface_x,
+                                (const double(*)[MPS_DIM])s->iface_v, s->iface_surface,
+                                s->iface_fixed};
+    return MPS_OK;
+}
+
+static int op_probe_count(const void *self)
+{
+    return ((const struct solid_mps *)self)->nprobes;
+}
+
+static const char *op_probe_name(const void *self, int k)
+{
+    return ((const struct solid_mps *)self)->scene.probes[k].name;
+}
+
+static double op_probe_value(const void *self, int k)
+{
+    return solid_mps_probe(self, k);
+}
+
+static size_t op_snapshot(void *self, const double (**x)[MPS_DIM], struct mps_field *fields,
+                          int max_fields, int *nfields)
+{
+    struct solid_mps *s = self;
+    strain_pass(s); /* q of the current state */
+    for (size_t i = 0; i < s->n; i++) {
+        const struct solid_mps_material *m = &s->mat[s->body[i]];
+        s->pressure[i] = s->q[i] * m->rho;
+        for (int a = 0; a < MPS_DIM; a++)
+            s->disp[i][a] = s->x[i][a] - s->x0[i][a];
+    }
+    *x = (const double(*)[MPS_DIM])s->x;
+    *nfields = mps_particles_output(&s->ps, fields, max_fields);
+    return s->n;
+}
+
+static void op_summary(const void *self, struct mps_json *j)
+{
+    const struct solid_mps *s = self;
+    mps_json_str(j, "model", "mps");
+    mps_json_int(j, "bonds", (long long)s->nbonds);
+    mps_json_int(j, "fixed_particles", (long long)(s->n - s->nfree));
+    mps_json_num(j, "dt_stable", solid_mps_stable_dt(s));
+    mps_json_num(j, "courant", s->courant);
+    mps_json_str(j, "plane", s->scene.plane == SOLID_PLANE_STRAIN ? "strain" : "stress");
+    struct solid_mps_diag d;
+    solid_mps_diag(s, &d);
+    mps_json_object(j, "final");
+    mps_json_num(j, "kinetic_energy", d.kinetic);
+    mps_json_num(j, "elastic_energy", d.elastic);
+    mps_json_num(j, "gravity_energy", d.gravity);
+    mps_json_num(j, "momentum_x", d.momentum[0]);
+    mps_json_num(j, "momentum_y", d.momentum[1]);
+    mps_json_num(j, "angular_momentum", d.angular);
+    mps_json_close(j);
+    mps_json_object(j, "phase_seconds");
+    for (int p = 0; p < s->timer.nphases; p++)
+        mps_json_num(j, s->timer.names[p], s->timer.seconds[p]);
+    mps_json_close(j);
+}
+
+static void op_destroy(void **self)
+{
+    struct solid_mps *s = *self;
+    solid_mps_destroy(&s);
+    *self = NULL;
+}
+
+const struct solid_model_ops solid_mps_ops = {
+    .name = "mps",
+    .create = op_create,
+    .stable_dt = op_stable_dt,
+    .set_loads = op_set_loads,
+    .advance = op_advance,
+    .interface = op_interface,
+    .probe_count = op_probe_count,
+    .probe_name = op_probe_name,
+    .probe_value = op_probe_value,
+    .snapshot = op_snapshot,
+    .summary = op_summary,
+    .destroy = op_destroy,
+};

@@ -1,0 +1,203 @@
+#include "solid_peer.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "mps_case.h"
+#include "mps_cli.h"
+#include "mps_json.h"
+#include "mps_timer.h"
+#include "proto_solver.h"
+#include "solid_scene.h"
+
+#define MAX_FIELDS 24
+
+struct peer {
+    const struct solid_model_ops *ops;
+    void *model;
+    struct mps_case *cs;
+    struct mps_h5_series *h5;
+    char out[4096];
+    char probe_names[4096];
+    double *probes;
+    double depth;          /* interface depth, m */
+    double t_output;
+    long substeps;
+    double max_ratio;      /* largest sub-step / stable step seen */
+    struct proto_solver_stats stats;
+    double wall0;
+};
+
+static enum mps_status snapshot(struct peer *p, double t, long step, struct mps_err *err)
+{
+    double w0 = mps_wall_seconds();
+    const double(*x)[MPS_DIM] = NULL;
+    struct mps_field f[MAX_FIELDS];
+    int nf = 0;
+    size_t n = p->ops->snapshot(p->model, &x, f, MAX_FIELDS, &nf);
+    enum mps_status st = mps_h5_write(p->h5, t, step, n, x, f, nf, err);
+    p->t_output += mps_wall_seconds() - w0;
+    return st;
+}
+
+static enum mps_status state(struct peer *p, struct proto_msg *m, struct mps_err *err)
+{
+    struct solid_iface iface;
+    enum mps_status st = p->ops->interface(p->model, p->depth, &iface, err);
+    if (st)
+        return st;
+    m->payload = PROTO_STATE;
+    m->count = iface.n;
+    m->id = iface.id;
+    m->x = iface.x;
+    m->v = iface.v;
+    m->surface = iface.surface;
+    m->fixed = iface.fixed;
+    m->dt = p->ops->stable_dt(p->model);
+    return MPS_OK;
+}
+
+static enum mps_status configure(void *self, const char *case_path, const char *out,
+                                 const char *prefix, struct mps_err *err)
+{
+    struct peer *p = self;
+    snprintf(p->out, sizeof p->out, "%s", out);
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const char *const ignore[] = {"fluid.", "coupling.", NULL};
+    enum mps_status st = mps_case_load(&p->cs, case_path, NULL, 0, tables, 2, ignore, err);
+    if (st)
+        return st;
+    if (!p->ops && !(p->ops = solid_model_find(mps_case_string(p->cs, "solid.model"))))
+        return mps_case_fail(p->cs, err, "solid.model", "unknown model (known: %s)",
+                             solid_model_names());
+    if ((st = p->ops->create(&p->model, p->cs, err)))
+        return st;
+    p->depth = mps_case_double(p->cs, "solid.interface_depth") * mps_case_double(p->cs, "dp");
+    int n = p->ops->probe_count(p->model);
+    const char *names[256];
+    for (int k = 0; k < n && k < 256; k++)
+        names[k] = p->ops->probe_name(p->model, k);
+    proto_join_names(names, n < 256 ? n : 256, p->probe_names, sizeof p->probe_names);
+    p->probes = calloc((size_t)n + 1, sizeof *p->probes);
+    if (!p->probes)
+        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+    char *yaml = mps_case_resolved_yaml(p->cs);
+    st = mps_h5_open(&p->h5, out, prefix, "solid_solver", yaml ? yaml : "", err);
+    free(yaml);
+    if (!st && mps_case_double(p->cs, "output.interval") > 0.0)
+        st = snapshot(p, 0.0, 0, err);
+    return st;
+}
+
+static enum mps_status ready(void *self, struct proto_msg *reply, struct mps_err *err)
+{
+    struct peer *p = self;
+    reply->nprobes = p->ops->probe_count(p->model);
+    reply->text = p->probe_names[0] ? p->probe_names : NULL;
+    return state(p, reply, err);
+}
+
+static enum mps_status advance(void *self, const struct proto_msg *in, struct proto_msg *reply,
+                               struct mps_err *err)
+{
+    struct peer *p = self;
+    enum mps_status st;
+    if (in->payload == PROTO_STATE)
+        return mps_err_set(err, MPS_EPROTO, "the solid was sent STATE; it takes LOADS or NONE");
+    struct solid_loads loads = {0};
+    if (in->payload == PROTO_LOADS)
+        loads = (struct solid_loads){in->count, in->id, in->pressure, in->force};
+    if ((st = p->ops->set_loads(p->model, &loads, err)))
+        return st;
+    /* n_sub sub-steps of dt/n_sub, the fluid's load held over them (paper 4.6) */
+    double h = in->dt / in->n_sub, stable = p->ops->stable_dt(p->model);
+    if (h > stable * (1.0 + 1e-9))
+        return mps_err_set(err, MPS_EPROTO,
+                           "sub-step %.3g s (dt %.3g s / %d) exceeds the stable step %.3g s", h,
+                           in->dt, in->n_sub, stable);
+    if (h / stable > p->max_ratio)
+        p->max_ratio = h / stable;
+    for (int k = 0; k < in->n_sub; k++)
+        if ((st = p->ops->advance(p->model, h, err)))
+            return mps_err_prefix(err, "t = %.6g s: ", in->time + k * h);
+    p->substeps += in->n_sub;
+    if ((st = state(p, reply, err)))
+        return st;
+    if (in->flags & PROTO_F_PROBES) {
+        reply->nprobes = p->ops->probe_count(p->model);
+        for (int k = 0; k < reply->nprobes; k++)
+            p->probes[k] = p->ops->probe_value(p->model, k);
+        reply->probes = p->probes;
+    }
+    if (in->flags & PROTO_F_SNAPSHOT)
+        st = snapshot(p, in->time + in->dt, in->step + 1, err);
+    return st;
+}
+
+static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const struct mps_err *err)
+{
+    struct mps_json j;
+    mps_json_begin(&j, fp);
+    mps_json_str(&j, "solver", "solid_solver");
+    mps_json_str(&j, "model", p->ops ? p->ops->name : "");
+    mps_json_str(&j, "version", MPS_VERSION);
+    mps_json_str(&j, "status", mps_status_name(st));
+    mps_json_str(&j, "message", st ? err->msg : "");
+    mps_json_num(&j, "wall_seconds", mps_wall_seconds() - p->wall0);
+    mps_json_num(&j, "setup_seconds", p->stats.setup_seconds);
+    mps_json_num(&j, "compute_seconds", p->stats.compute_seconds);
+    mps_json_num(&j, "wait_seconds", p->stats.wait_seconds);
+    mps_json_num(&j, "output_seconds", p->t_output);
+    mps_json_int(&j, "coupling_steps", p->stats.advances);
+    mps_json_int(&j, "substeps", p->substeps);
+    mps_json_num(&j, "substeps_per_coupling_step",
+                 p->stats.advances ? (double)p->substeps / p->stats.advances : 0.0);
+    mps_json_num(&j, "largest_substep_over_stable", p->max_ratio);
+    if (p->model && p->ops->summary) {
+        mps_json_object(&j, "model_summary");
+        p->ops->summary(p->model, &j);
+        mps_json_close(&j);
+    }
+    mps_json_end(&j);
+}
+
+static char *finish(void *self, enum mps_status st, const struct mps_err *err)
+{
+    struct peer *p = self;
+    char path[4200];
+    snprintf(path, sizeof path, "%s/solid_summary.json", p->out);
+    FILE *fp = fopen(path, "w");
+    if (fp) {
+        summary_json(p, fp, st, err);
+        fclose(fp);
+    }
+    char *text = NULL;
+    size_t len = 0;
+    FILE *mem = open_memstream(&text, &len);
+    if (mem) {
+        summary_json(p, mem, st, err);
+        fclose(mem);
+    }
+    return text;
+}
+
+int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int hello_timeout_ms,
+                   volatile const int *stop_flag)
+{
+    struct peer p = {.ops = ops};
+    p.wall0 = mps_wall_seconds();
+    struct proto_solver_ops pops = {"solid", ops ? ops->name : "case", configure, ready, advance,
+                                    finish};
+    struct mps_err err = {0};
+    enum mps_status st =
+        proto_solver_run(endpoint, &pops, &p, hello_timeout_ms, stop_flag, &p.stats, &err);
+    if (st)
+        fprintf(stderr, "solid_solver: %s: %s\n", mps_status_name(st), err.msg);
+    mps_h5_close(&p.h5);
+    if (p.model)
+        p.ops->destroy(&p.model);
+    mps_case_destroy(&p.cs);
+    free(p.probes);
+    return mps_status_exit_code(st);
+}

@@ -1,0 +1,226 @@
+#include "solid_scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#define ANY (MPS_KEY_NO_LO | MPS_KEY_NO_HI)
+#define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
+
+/* Courant default 0.9: C = 1 is at or below the linear stability limit of
+ * bodies 3 or more particles thick, a strip 2 particles thick goes unstable
+ * at 0.96 (solid_mps.h, test_solid_stability). */
+const struct mps_key_spec solid_case_keys[] = {
+    {"solid.model", MPS_KEY_ENUM, "mps", 0, 0, 0, "mps|tlsph", "", "solid model"},
+    {"solid.tlsph.alpha", MPS_KEY_DOUBLE, "1", 0, 0, MPS_KEY_NO_HI, NULL, "",
+     "TLSPH artificial viscosity coefficient (solid_tlsph.h)"},
+    {"solid.tlsph.hourglass", MPS_KEY_DOUBLE, "0.05", 0, 0, MPS_KEY_NO_HI, NULL, "",
+     "TLSPH hourglass stiffness, fraction of E (solid_tlsph.h)"},
+    {"solid.tlsph.correction", MPS_KEY_ENUM, "linear", 0, 0, 0, "linear|quadratic", "",
+     "TLSPH kernel gradient correction: exact for linear or quadratic fields"},
+    {"solid.courant", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "fraction of the stable explicit step, in (0, 1]"},
+    {"solid.plane", MPS_KEY_ENUM, "strain", 0, 0, 0, "strain|stress", "",
+     "2D Lame constants: plane strain (Eq. 4 as printed) or plane stress"},
+    {"solid.interface_depth", MPS_KEY_DOUBLE, "2.1", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
+     "dp", "inner particles within this depth of the surface are sent to a coupled fluid (its "
+     "number-density radius)"},
+    {"solid.bodies.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
+     "body name, used by clamps"},
+    {"solid.bodies.*.x0", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "left edge of the body"},
+    {"solid.bodies.*.y0", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "bottom edge of the body"},
+    {"solid.bodies.*.x1", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "right edge of the body"},
+    {"solid.bodies.*.y1", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "top edge of the body"},
+    {"solid.bodies.*.rho", MPS_KEY_DOUBLE, NULL, 0, 0, POS | MPS_KEY_REQUIRED, NULL, "kg/m^3",
+     "density"},
+    {"solid.bodies.*.E", MPS_KEY_DOUBLE, NULL, 0, 0, POS | MPS_KEY_REQUIRED, NULL, "Pa",
+     "Young's modulus"},
+    {"solid.bodies.*.nu", MPS_KEY_DOUBLE, NULL, -1, 0.5,
+     MPS_KEY_LO_OPEN | MPS_KEY_HI_OPEN | MPS_KEY_REQUIRED, NULL, "", "Poisson's ratio"},
+    {"solid.bodies.*.vx", MPS_KEY_DOUBLE, "0", 0, 0, ANY, NULL, "m/s", "initial velocity, x"},
+    {"solid.bodies.*.vy", MPS_KEY_DOUBLE, "0", 0, 0, ANY, NULL, "m/s", "initial velocity, y"},
+    {"solid.clamps.*.body", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
+     "name of the clamped body"},
+    {"solid.clamps.*.x0", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "clamp region, left"},
+    {"solid.clamps.*.y0", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "clamp region, bottom"},
+    {"solid.clamps.*.x1", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "clamp region, right"},
+    {"solid.clamps.*.y1", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "clamp region, top"},
+    {"solid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
+     "column name in probes.csv"},
+    {"solid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED, "dx|dy|x|y", "",
+     "displacement or position component"},
+    {"solid.probes.*.x", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "probe point: the nearest particle(s) at start"},
+    {"solid.probes.*.y", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
+     "probe point: the nearest particle(s) at start"},
+    {.name = NULL},
+};
+
+/* Centres at lo + dp/2 + i dp inside [lo, hi]; the tolerance absorbs the
+ * rounding of (hi - lo) / dp when the span is a whole number of spacings. */
+static long lattice_count(double lo, double hi, double dp)
+{
+    double n = floor((hi - lo) / dp + 1e-6);
+    return n > 0 ? (long)n : 0;
+}
+
+void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
+{
+    const struct solid_body_def *d = &s->bodies[b];
+    *nx = lattice_count(d->x0, d->x1, s->dp);
+    *ny = lattice_count(d->y0, d->y1, s->dp);
+    if (*nx == 0 || *ny == 0)
+        *nx = *ny = 0;
+}
+
+void solid_scene_lame(const struct solid_scene *s, int b, double *lambda, double *mu)
+{
+    double E = s->bodies[b].E, nu = s->bodies[b].nu;
+    *mu = E / (2.0 * (1.0 + nu)); /* Eq. 4 */
+    if (s->plane == SOLID_PLANE_STRAIN)
+        *lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)); /* Eq. 4 */
+    else
+        *lambda = E * nu / (1.0 - nu * nu);
+}
+
+/* Lattice points of body b inside [x0, x1] x [y0, y1]. */
+static long count_inside(const struct solid_scene *s, int b, double x0, double y0, double x1,
+                         double y1)
+{
+    long nx, ny, k = 0;
+    solid_scene_lattice(s, b, &nx, &ny);
+    const struct solid_body_def *d = &s->bodies[b];
+    for (long i = 0; i < nx; i++) {
+        double x = d->x0 + s->dp * (0.5 + (double)i);
+        if (x < x0 || x > x1)
+            continue;
+        for (long j = 0; j < ny; j++) {
+            double y = d->y0 + s->dp * (0.5 + (double)j);
+            k += (y >= y0 && y <= y1);
+        }
+    }
+    return k;
+}
+
+static void copy_name(char *dst, const char *src)
+{
+    snprintf(dst, SOLID_NAME_MAX, "%s", src);
+}
+
+enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c,
+                                 struct mps_err *err)
+{
+    memset(s, 0, sizeof *s);
+    char key[128];
+    s->dp = mps_case_double(c, "dp");
+    s->g[0] = mps_case_double(c, "gravity.x");
+    s->g[1] = mps_case_double(c, "gravity.y");
+    s->courant = mps_case_double(c, "solid.courant");
+    s->plane = strcmp(mps_case_string(c, "solid.plane"), "strain") == 0 ? SOLID_PLANE_STRAIN
+                                                                          : SOLID_PLANE_STRESS;
+
+    s->nbodies = mps_case_count(c, "solid.bodies");
+    if (s->nbodies == 0)
+        return mps_err_set(err, MPS_EINPUT, "%s: solid.bodies: no solid body given",
+                           mps_case_path(c));
+    if (s->nbodies > SOLID_MAX_BODIES)
+        return mps_case_fail(c, err, "solid.bodies", "%d bodies: at most %d", s->nbodies,
+                             SOLID_MAX_BODIES);
+    for (int b = 0; b < s->nbodies; b++) {
+        struct solid_body_def *d = &s->bodies[b];
+        snprintf(key, sizeof key, "solid.bodies.%d.name", b);
+        if (!mps_case_has(c, "%s", key))
+            return mps_err_set(err, MPS_EINPUT, "%s: solid.bodies.%d: missing (a gap in the "
+                               "list of bodies)", mps_case_path(c), b);
+        copy_name(d->name, mps_case_string(c, "%s", key));
+        d->x0 = mps_case_double(c, "solid.bodies.%d.x0", b);
+        d->y0 = mps_case_double(c, "solid.bodies.%d.y0", b);
+        d->x1 = mps_case_double(c, "solid.bodies.%d.x1", b);
+        d->y1 = mps_case_double(c, "solid.bodies.%d.y1", b);
+        d->rho = mps_case_double(c, "solid.bodies.%d.rho", b);
+        d->E = mps_case_double(c, "solid.bodies.%d.E", b);
+        d->nu = mps_case_double(c, "solid.bodies.%d.nu", b);
+        d->v[0] = mps_case_double(c, "solid.bodies.%d.vx", b);
+        d->v[1] = mps_case_double(c, "solid.bodies.%d.vy", b);
+        for (int a = 0; a < b; a++)
+            if (strcmp(s->bodies[a].name, d->name) == 0)
+                return mps_case_fail(c, err, key, "body name already used by "
+                                     "solid.bodies.%d", a);
+        long nx, ny;
+        solid_scene_lattice(s, b, &nx, &ny);
+        if (nx == 0) {
+            int wide = d->x1 - d->x0 >= s->dp;
+            snprintf(key, sizeof key, "solid.bodies.%d.%s", b, wide ? "y1" : "x1");
+            return mps_case_fail(c, err, key, "body '%s' holds no particle: it must reach at "
+                                 "least dp = %g beyond %s", d->name, s->dp,
+                                 wide ? "y0" : "x0");
+        }
+    }
+
+    s->nclamps = mps_case_count(c, "solid.clamps");
+    if (s->nclamps > SOLID_MAX_CLAMPS)
+        return mps_case_fail(c, err, "solid.clamps", "%d clamps: at most %d", s->nclamps,
+                             SOLID_MAX_CLAMPS);
+    for (int k = 0; k < s->nclamps; k++) {
+        struct solid_clamp_def *d = &s->clamps[k];
+        snprintf(key, sizeof key, "solid.clamps.%d.body", k);
+        if (!mps_case_has(c, "%s", key))
+            return mps_err_set(err, MPS_EINPUT, "%s: solid.clamps.%d: missing (a gap in the "
+                               "list of clamps)", mps_case_path(c), k);
+        const char *name = mps_case_string(c, "%s", key);
+        d->body = -1;
+        for (int b = 0; b < s->nbodies; b++)
+            if (strcmp(s->bodies[b].name, name) == 0)
+                d->body = b;
+        if (d->body < 0) {
+            char names[512] = "";
+            for (int b = 0; b < s->nbodies; b++)
+                snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
+                         b ? ", " : "", s->bodies[b].name);
+            return mps_case_fail(c, err, key, "no body of that name (bodies: %s)", names);
+        }
+        d->x0 = mps_case_double(c, "solid.clamps.%d.x0", k);
+        d->y0 = mps_case_double(c, "solid.clamps.%d.y0", k);
+        d->x1 = mps_case_double(c, "solid.clamps.%d.x1", k);
+        d->y1 = mps_case_double(c, "solid.clamps.%d.y1", k);
+        if (count_inside(s, d->body, d->x0, d->y0, d->x1, d->y1) == 0) {
+            snprintf(key, sizeof key, "solid.clamps.%d.x0", k);
+            return mps_case_fail(c, err, key, "empty clamp: region [%g, %g] x [%g, %g] "
+                                 "holds no particle centre of body '%s'", d->x0, d->x1, d->y0,
+                                 d->y1, name);
+        }
+    }
+
+    s->nprobes = mps_case_count(c, "solid.probes");
+    if (s->nprobes > SOLID_MAX_PROBES)
+        return mps_case_fail(c, err, "solid.probes", "%d probes: at most %d", s->nprobes,
+                             SOLID_MAX_PROBES);
+    for (int k = 0; k < s->nprobes; k++) {
+        struct solid_probe_def *d = &s->probes[k];
+        snprintf(key, sizeof key, "solid.probes.%d.name", k);
+        if (!mps_case_has(c, "%s", key))
+            return mps_err_set(err, MPS_EINPUT, "%s: solid.probes.%d: missing (a gap in the "
+                               "list of probes)", mps_case_path(c), k);
+        copy_name(d->name, mps_case_string(c, "%s", key));
+        const char *kind = mps_case_string(c, "solid.probes.%d.kind", k);
+        d->kind = strcmp(kind, "dx") == 0  ? SOLID_PROBE_DX
+                  : strcmp(kind, "dy") == 0 ? SOLID_PROBE_DY
+                  : strcmp(kind, "x") == 0  ? SOLID_PROBE_X
+                                            : SOLID_PROBE_Y;
+        d->x = mps_case_double(c, "solid.probes.%d.x", k);
+        d->y = mps_case_double(c, "solid.probes.%d.y", k);
+        for (int a = 0; a < k; a++)
+            if (strcmp(s->probes[a].name, d->name) == 0)
+                return mps_case_fail(c, err, key, "probe name already used by "
+                                     "solid.probes.%d", a);
+    }
+    return MPS_OK;
+}

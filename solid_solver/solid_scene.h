@@ -1,0 +1,72 @@
+/* The solid scene as plain data: bodies (rectangles filled with a square
+ * lattice), clamps and probes, read from the "solid." keys of a case and
+ * checked (every error names file, line and key). Tests and tools can also
+ * fill a scene by hand and skip the case loader. Units SI, 2D per metre depth. */
+#ifndef SOLID_SCENE_H
+#define SOLID_SCENE_H
+
+#include "mps_case.h"
+#include "mps_dim.h"
+#include "mps_err.h"
+
+#define SOLID_MAX_BODIES 32
+#define SOLID_MAX_CLAMPS 32
+#define SOLID_MAX_PROBES 64
+#define SOLID_NAME_MAX 64
+
+/* Lame constants from (E, nu): "strain" is Eq. 4 as printed (3D / plane
+ * strain); "stress" uses the plane-stress lambda = E nu / (1 - nu^2), for which
+ * a 2D beam bends with E itself (the paper's Eq. 53-54 assume E). */
+enum solid_plane { SOLID_PLANE_STRAIN, SOLID_PLANE_STRESS };
+
+enum solid_probe_kind {
+    SOLID_PROBE_DX, /* x displacement, m */
+    SOLID_PROBE_DY, /* y displacement, m */
+    SOLID_PROBE_X,  /* x position, m */
+    SOLID_PROBE_Y   /* y position, m */
+};
+
+struct solid_body_def {
+    char name[SOLID_NAME_MAX];
+    double x0, y0, x1, y1;   /* rectangle, m; centres at x0 + dp/2 + i dp */
+    double rho, E, nu;       /* kg/m^3, Pa, - */
+    double v[MPS_DIM];       /* initial velocity, m/s */
+};
+
+struct solid_clamp_def {
+    int body;                /* index into bodies */
+    double x0, y0, x1, y1;   /* particles of body with centres inside are fixed */
+};
+
+struct solid_probe_def {
+    char name[SOLID_NAME_MAX];
+    enum solid_probe_kind kind;
+    double x, y;             /* the particle(s) nearest this point at start */
+};
+
+struct solid_scene {
+    double dp;               /* lattice spacing, m */
+    double g[MPS_DIM];       /* body force per unit mass, m/s^2 */
+    double courant;          /* (0, 1]: fraction of the stable step, see solid_mps.h */
+    enum solid_plane plane;
+    int nbodies, nclamps, nprobes;
+    struct solid_body_def bodies[SOLID_MAX_BODIES];
+    struct solid_clamp_def clamps[SOLID_MAX_CLAMPS];
+    struct solid_probe_def probes[SOLID_MAX_PROBES];
+};
+
+/* The solid keys ("solid.*"), for mps_case_load (with mps_case_common_keys). */
+extern const struct mps_key_spec solid_case_keys[];
+
+/* Reads and checks the scene (a body with no particles, an empty clamp, a
+ * clamp naming an unknown body are errors naming the key). */
+enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c,
+                                 struct mps_err *err);
+
+/* Lattice columns and rows of body b (0 if it holds no particle). */
+void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny);
+
+/* Lame constants of body b, Pa (Eq. 4, or plane stress, see enum solid_plane). */
+void solid_scene_lame(const struct solid_scene *s, int b, double *lambda, double *mu);
+
+#endif
