@@ -92,6 +92,9 @@ enum mps_status launch_start(struct child *c, const char *name, const char *comm
         if (getppid() != parent)
             _exit(126);
         setpgid(0, 0);
+        /* the solvers take turns on the same cores: OpenMP threads that spin
+         * while the other solver runs cost it up to 20x (docs/ppe_solvers.md) */
+        setenv("OMP_WAIT_POLICY", "passive", 0);
         execvp(words[0], words);
         fprintf(stderr, "coupler: cannot start the %s solver '%s': %s\n", name, words[0],
                 strerror(errno));

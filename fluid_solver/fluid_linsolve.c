@@ -1,6 +1,6 @@
-/* Sparse SPD solves for the PPE: PCG (Jacobi or IC(0)) and CHOLMOD.
- * See fluid_linsolve.h for the contract and docs/ppe_solvers.md for the
- * measurements behind "auto". */
+/* Sparse SPD solves for the PPE: PCG (Jacobi or block IC(0), OpenMP) and
+ * CHOLMOD (int version). See fluid_linsolve.h for the contract and
+ * docs/ppe_solvers.md for the measurements behind the choices here. */
 #include "fluid_linsolve.h"
 
 #include <math.h>
@@ -15,12 +15,17 @@ enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE };
 
 static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse"};
 
-/* "auto": warm-started PCG with the IC(0) preconditioner. On the synthetic
- * PPE (jittered lattice, ~48 nnz/row, rtol 1e-8, 2 cores, min of 3 runs, see
- * docs/ppe_solvers.md) warm-started pcg_ic0 took 4 / 19 / 104 ms at
- * n = 5k / 20k / 80k against 5 / 22 / 125 ms for pcg_jacobi and
- * 29 / 140 / 780 ms for cholmod_reuse, with ~3x fewer iterations than Jacobi
- * (so fewer chances to stall on a harder real matrix). */
+/* "auto" = pcg_ic0. Measured with bench/linsolve_bench on the synthetic PPE
+ * (jittered lattice, ~46 nnz/row, rtol 1e-6, min of 3 runs; see
+ * docs/ppe_solvers.md), warm-started solve in ms at n = 5k / 20k / 80k:
+ *   2 threads, quiet machine: pcg_ic0 4.6 / 22 / 137, pcg_jacobi 4.3 / 24 / 111
+ *   1 thread (what 2 threads give, at best, next to another busy process):
+ *                             pcg_ic0 6.5 / 37 / 224, pcg_jacobi 8.4 / 55 / 253
+ *   cholmod 41 / 213 / 1850, cholmod_reuse 39 / 230 / 1890.
+ * Roughly a tie on two free cores (Jacobi 20% ahead at 80k), IC(0) 11-34%
+ * ahead when the cores are shared (the usual case for a coupled run here),
+ * and 3-4x fewer iterations, which keeps a margin under fluid.ppe_max_iter
+ * on harder matrices. */
 #define AUTO_METHOD M_PCG_IC0
 
 #define METHOD_LIST "pcg_jacobi, pcg_ic0, cholmod, cholmod_reuse, auto"
@@ -43,10 +48,11 @@ struct fluid_linsolve {
     double *partial;     /* nthreads * PAD reduction slots */
 
     /* IC(0) factor: lower triangle of A in CSR (diagonal last in each row),
-     * overwritten by L; the diagonal is kept inverted in linv. */
+     * restricted to each block, overwritten by L; 1/L_ii in linv. */
     size_t cap_lnz;
     int *lptr, *lcol, *mark;
     double *lval, *linv;
+    int nblk;            /* blocks of rows factorised independently (one per thread) */
 
     /* CHOLMOD */
     int cm_started;
@@ -59,6 +65,8 @@ struct fluid_linsolve {
     int *pat_ptr, *pat_col;     /* copy of the pattern the symbolic factor L was built for */
     size_t cap_perm, cap_pat;
     double flops_ref;    /* factorisation flops / nnz(A) of the last fresh ordering */
+    int rejected;        /* consecutive times the old ordering was not good enough */
+    int skip;            /* calls left before it is tried again */
 };
 
 /* ---- CHOLMOD error capture: the handler has no user pointer, so the last
@@ -483,39 +491,43 @@ static void k_direction(struct fluid_linsolve *s, int n, double beta, const doub
 
 /* ---------------------------------------------------------------------- */
 /* IC(0): L L^T ~= A with L restricted to the lower-triangle pattern of A
- * (Meijerink & van der Vorst 1977; it exists for M-matrices). Row-oriented:
- * L_ik = (a_ik - sum_{j<k} L_ij L_kj) / L_kk over the common pattern. The
- * common pattern is found without a branch: mark[j] is the position of L_ij
- * for the columns of row i and otherwise a sentinel position holding 0.
- * Returns -1 on success or the row whose pivot was not positive. */
-static int ic0_factor(struct fluid_linsolve *s, const struct fluid_csr *A, double shift)
+ * (Meijerink & van der Vorst 1977; it exists for M-matrices), computed per
+ * block of rows: with nblk > 1 the couplings between blocks are dropped
+ * (block-Jacobi IC(0)), so each thread factorises and solves its own block.
+ * Measured on the synthetic PPE with 2 threads: a few more iterations, but
+ * set-up and triangular solves run in parallel (see docs/ppe_solvers.md).
+ * Blocks are fixed row ranges, so the result depends on the number of
+ * blocks, never on scheduling. */
+static inline int blk_lo(int n, int nblk, int b) { return (int)((long long)n * b / nblk); }
+
+/* Rows [lo, hi) of block b. Row-oriented: L_ik = (a_ik - sum_{j<k} L_ij L_kj)
+ * / L_kk over the common pattern, found without a branch: mark[j] is the
+ * position of L_ij for the columns of row i and otherwise a sentinel
+ * position holding 0. Returns -1 on success or the row whose pivot was not
+ * positive. */
+static int ic0_factor_block(struct fluid_linsolve *s, const struct fluid_csr *A, int lo, int hi,
+                            double shift)
 {
-    int n = A->n;
     int *lptr = s->lptr, *lcol = s->lcol, *mark = s->mark;
     double *lval = s->lval, *linv = s->linv;
-    /* Copy the lower triangle (diagonal is the last entry of each row). */
-    int nz = 0;
-    lptr[0] = 0;
-    for (int i = 0; i < n; i++) {
-        int end = s->diag[i];
-        for (int k = A->rowptr[i]; k <= end; k++) {
+    const int zero = lptr[A->n];
+    for (int i = lo; i < hi; i++) {   /* copy the block's lower triangle */
+        int nz = lptr[i], k = A->rowptr[i];
+        while (A->col[k] < lo)
+            k++;
+        for (; k <= s->diag[i]; k++) {
             lcol[nz] = A->col[k];
-            lval[nz] = A->val[k];
-            nz++;
+            lval[nz++] = A->val[k];
         }
         lval[nz - 1] *= 1.0 + shift;
-        lptr[i + 1] = nz;
-    }
-    const int zero = nz;
-    lval[zero] = 0.0;
-    for (int i = 0; i < n; i++)
         mark[i] = zero;
-    for (int i = 0; i < n; i++) {
-        int lo = lptr[i], dpos = lptr[i + 1] - 1;
-        for (int p = lo; p < dpos; p++)
+    }
+    for (int i = lo; i < hi; i++) {
+        int rlo = lptr[i], dpos = lptr[i + 1] - 1;
+        for (int p = rlo; p < dpos; p++)
             mark[lcol[p]] = p;
         double dsum = 0.0;
-        for (int p = lo; p < dpos; p++) {
+        for (int p = rlo; p < dpos; p++) {
             int k = lcol[p];
             double v = lval[p];
             int kend = lptr[k + 1] - 1;
@@ -525,7 +537,7 @@ static int ic0_factor(struct fluid_linsolve *s, const struct fluid_csr *A, doubl
             lval[p] = v;
             dsum += v * v;
         }
-        for (int p = lo; p < dpos; p++)
+        for (int p = rlo; p < dpos; p++)
             mark[lcol[p]] = zero;
         double d = lval[dpos] - dsum;
         /* A pivot that lost all but 1e-14 of the diagonal is as bad as a negative one. */
@@ -537,14 +549,55 @@ static int ic0_factor(struct fluid_linsolve *s, const struct fluid_csr *A, doubl
     return -1;
 }
 
+/* Returns -1 or the first row (over all blocks) whose pivot failed. */
+static int ic0_factor(struct fluid_linsolve *s, const struct fluid_csr *A, double shift)
+{
+    int n = A->n, nblk = s->nblk, bad = n;
+#pragma omp parallel for num_threads(nblk) if (nblk > 1) schedule(static, 1) reduction(min : bad)
+    for (int b = 0; b < nblk; b++) {
+        int row = ic0_factor_block(s, A, blk_lo(n, nblk, b), blk_lo(n, nblk, b + 1), shift);
+        if (row >= 0 && row < bad)
+            bad = row;
+    }
+    return bad < n ? bad : -1;
+}
+
 static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_csr *A,
                                  struct mps_err *err)
 {
     int n = A->n;
-    size_t lnz = 0;
+    int *lptr = s->lptr;
+    for (s->nblk = n >= PAR_MIN_ROWS ? s->nthreads : 1;; s->nblk = 1) {
+        /* Row lengths of L (block-local lower triangle); count what the
+         * split drops. */
+        int nblk = s->nblk;
+        long long dropped = 0, kept = 0;
+#pragma omp parallel for num_threads(nblk) if (nblk > 1) schedule(static, 1) \
+    reduction(+ : dropped, kept)
+        for (int b = 0; b < nblk; b++) {
+            int lo = blk_lo(n, nblk, b), hi = blk_lo(n, nblk, b + 1);
+            for (int i = lo; i < hi; i++) {
+                int k = A->rowptr[i];
+                while (A->col[k] < lo)
+                    k++;
+                lptr[i + 1] = s->diag[i] - k + 1;
+                dropped += k - A->rowptr[i];
+                kept += s->diag[i] - k;
+            }
+        }
+        /* Measured (synthetic PPE, 20k rows, 2 blocks): iterations grow 1.3x
+         * when 1% of the lower-triangle couplings are dropped, 1.55x at 6%,
+         * 1.7x at 10%, 2.2x at 23%, while a 2-block iteration costs 1/1.85 of
+         * a sequential one. A row-major lattice numbering, which particles
+         * sorted by cell resemble (fluid.c sorts every 20 steps), drops about
+         * 1%; a scrambled numbering drops half. */
+        if (nblk == 1 || dropped <= 0.1 * (double)(dropped + kept))
+            break;
+    }
+    lptr[0] = 0;
     for (int i = 0; i < n; i++)
-        lnz += (size_t)(s->diag[i] - A->rowptr[i] + 1);
-    lnz++;   /* the zero sentinel of ic0_factor */
+        lptr[i + 1] += lptr[i];
+    size_t lnz = (size_t)lptr[n] + 1;   /* + the zero sentinel of ic0_factor_block */
     if (lnz > s->cap_lnz) {
         size_t c = lnz + lnz / 8;
         int fail = 0;
@@ -555,6 +608,7 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
                                                 "(%zu entries)", lnz);
         s->cap_lnz = c;
     }
+    s->lval[lptr[n]] = 0.0;
     /* Shifted IC (Manteuffel 1980) as the fallback: scale the diagonal by
      * 1 + shift, shift = 1e-3, 1e-2, ..., until every pivot is positive. */
     double shift = 0.0;
@@ -570,31 +624,35 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
     return MPS_OK;
 }
 
-/* z = (L L^T)^{-1} r; returns r.z. Sequential: each row needs the previous. */
-static double ic0_apply(const struct fluid_linsolve *s, int n, const double *r, double *z)
+/* z = (L L^T)^{-1} r block by block; returns r.z. Within a block the solves
+ * are sequential: each row needs the previous ones. */
+static double ic0_apply(struct fluid_linsolve *s, int n, const double *r, double *z)
 {
-    const int *lptr = s->lptr, *lcol = s->lcol;
+    const int *lptr = s->lptr, *lcol = s->lcol, nblk = s->nblk;
     const double *lval = s->lval, *linv = s->linv;
-    for (int i = 0; i < n; i++) {   /* L y = r */
-        double v = r[i];
-        int dpos = lptr[i + 1] - 1;
-        for (int p = lptr[i]; p < dpos; p++)
-            v -= lval[p] * z[lcol[p]];
-        z[i] = v * linv[i];
+#pragma omp parallel for num_threads(nblk) if (nblk > 1) schedule(static, 1)
+    for (int b = 0; b < nblk; b++) {
+        int lo = blk_lo(n, nblk, b), hi = blk_lo(n, nblk, b + 1);
+        for (int i = lo; i < hi; i++) {   /* L y = r */
+            double v = r[i];
+            int dpos = lptr[i + 1] - 1;
+            for (int p = lptr[i]; p < dpos; p++)
+                v -= lval[p] * z[lcol[p]];
+            z[i] = v * linv[i];
+        }
+        double rz = 0.0;
+        for (int i = hi - 1; i >= lo; i--) {   /* L^T z = y, column by column */
+            double zi = z[i] * linv[i];
+            z[i] = zi;
+            rz += r[i] * zi;
+            int dpos = lptr[i + 1] - 1;
+            for (int p = lptr[i]; p < dpos; p++)
+                z[lcol[p]] -= lval[p] * zi;
+        }
+        s->partial[b * PAD] = rz;
     }
-    double rz = 0.0;
-    for (int i = n - 1; i >= 0; i--) {   /* L^T z = y, column by column */
-        double zi = z[i] * linv[i];
-        z[i] = zi;
-        rz += r[i] * zi;
-        int dpos = lptr[i + 1] - 1;
-        for (int p = lptr[i]; p < dpos; p++)
-            z[lcol[p]] -= lval[p] * zi;
-    }
-    return rz;
+    return gather(s, nblk, 0);
 }
-
-/* ---------------------------------------------------------------------- */
 
 static double precond(struct fluid_linsolve *s, int n, const double *r, double *z)
 {
@@ -732,9 +790,11 @@ static void remember_analysis(struct fluid_linsolve *s, const struct fluid_csr *
  * of the previous matrix of the same size and keeps it only if the predicted
  * factorisation flops (per nonzero of A) are within 10% of what the last
  * fresh ordering gave. Measured on the synthetic PPE: after a motion of 0.02
- * particle spacings the old ordering had 1.8x the fill and 4.5x the flops
- * (new edges cross its separators), while a fresh ordering costs only about
- * a quarter of a factorisation. */
+ * particle spacings the old ordering needed 4.5x (5k rows) to 9x (80k) the
+ * flops, as new edges cross its separators; a fresh ordering costs a quarter
+ * of a factorisation at 5k-20k rows and about as much at 80k (METIS). Trying
+ * costs a symbolic analysis, so after k rejections in a row the next 2^k
+ * calls (at most 64) do not try. */
 static enum mps_status analyse(struct fluid_linsolve *s, cholmod_sparse *As,
                                const struct fluid_csr *A, struct mps_err *err)
 {
@@ -742,7 +802,12 @@ static enum mps_status analyse(struct fluid_linsolve *s, cholmod_sparse *As,
     double nnz = (double)A->rowptr[A->n];
     int reuse = s->method == M_CHOLMOD_REUSE;
     cholmod_free_factor(&s->L, cm);
-    if (reuse && s->perm_n == A->n) {
+    int try_old = reuse && s->perm_n == A->n;
+    if (try_old && s->skip > 0) {
+        s->skip--;
+        try_old = 0;
+    }
+    if (try_old) {
         cm->nmethods = 1;
         cm->method[0].ordering = CHOLMOD_GIVEN;
         cm->postorder = 1;
@@ -754,10 +819,14 @@ static enum mps_status analyse(struct fluid_linsolve *s, cholmod_sparse *As,
             return cholmod_fail(s, "cholmod_analyze_p", err);
         }
         if (cm->fl <= 1.1 * s->flops_ref * nnz) {
+            s->rejected = 0;
             remember_analysis(s, A);
             return MPS_OK;
         }
         cholmod_free_factor(&s->L, cm);
+        if (s->rejected < 6)
+            s->rejected++;
+        s->skip = 1 << s->rejected;
     }
     s->L = cholmod_analyze(As, cm);
     if (!s->L || cm->status < CHOLMOD_OK) {

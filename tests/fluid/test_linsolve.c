@@ -1,0 +1,489 @@
+/* fluid_linsolve: every method on a PPE-like matrix (jittered 2D lattice,
+ * MPS weight w = re/r - 1 within re = 4 l0, top row free surface), checked
+ * with an independent residual, against each other, warm starts, ordering
+ * reuse across patterns, and the error paths. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "fluid_linsolve.h"
+#include "../test_util.h"
+
+static const char *const methods[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse", "auto"};
+#define NMETHODS 5
+
+struct mat {
+    int n, *rowptr, *col;
+    double *val;
+    double *y;   /* height of each unknown's particle, for a hydrostatic test solution */
+    struct fluid_csr csr;
+};
+
+static unsigned long long rng_state = 88172645463325252ull;
+static double urand(void)   /* xorshift64, uniform in [0, 1) */
+{
+    rng_state ^= rng_state << 13;
+    rng_state ^= rng_state >> 7;
+    rng_state ^= rng_state << 17;
+    return (double)(rng_state >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* nx x ny particles, spacing 1, uniform jitter +-jitter, then every particle
+ * moved by (drift, 0.5 drift) * sin(...) so a second call with another drift
+ * gives the same n but a different pattern. The top lattice row is the free
+ * surface (p = 0, no unknown). a_ii = (1 + eps) sum_j w_ij over all
+ * neighbours, a_ij = -w_ij between unknowns. */
+static void build(struct mat *m, int nx, int ny, double jitter, double drift, double eps)
+{
+    const double re = 4.0;
+    int np = nx * ny;
+    double (*x)[2] = malloc((size_t)np * sizeof *x);
+    for (int j = 0; j < ny; j++)
+        for (int i = 0; i < nx; i++) {
+            double *p = x[j * nx + i];
+            p[0] = i + jitter * (2.0 * urand() - 1.0);
+            p[1] = j + jitter * (2.0 * urand() - 1.0);
+            p[0] += drift * sin(0.3 * p[1]);
+            p[1] += 0.5 * drift * sin(0.2 * p[0]);
+        }
+    int n = nx * (ny - 1);   /* unknowns: all but the top row, numbered row-major */
+    m->n = n;
+    m->rowptr = malloc((size_t)(n + 1) * sizeof *m->rowptr);
+    m->col = malloc((size_t)n * 100 * sizeof *m->col);
+    m->val = malloc((size_t)n * 100 * sizeof *m->val);
+    m->y = malloc((size_t)n * sizeof *m->y);
+    int nz = 0, w = 6;   /* lattice window: re + drift + jitter < 6 */
+    m->rowptr[0] = 0;
+    for (int a = 0; a < n; a++) {
+        int ai = a % nx, aj = a / nx, dpos = -1;
+        double sum = 0.0;
+        for (int bj = aj - w; bj <= aj + w; bj++)
+            for (int bi = ai - w; bi <= ai + w; bi++) {
+                if (bi < 0 || bi >= nx || bj < 0 || bj >= ny)
+                    continue;
+                int b = bj * nx + bi;
+                if (b == a) {
+                    dpos = nz;
+                    m->col[nz] = a;
+                    m->val[nz++] = 0.0;
+                    continue;
+                }
+                double dx = x[b][0] - x[a][0], dy = x[b][1] - x[a][1];
+                double r = sqrt(dx * dx + dy * dy);
+                if (r >= re)
+                    continue;
+                double wij = re / r - 1.0;
+                sum += wij;
+                if (bj < ny - 1) {
+                    m->col[nz] = b;
+                    m->val[nz++] = -wij;
+                }
+            }
+        m->val[dpos] = (1.0 + eps) * sum;
+        m->rowptr[a + 1] = nz;
+        m->y[a] = x[a][1];
+    }
+    m->csr = (struct fluid_csr){n, m->rowptr, m->col, m->val};
+    free(x);
+}
+
+/* dst = src without the off-diagonal couplings weaker than wmin (a pattern
+ * subset, as if re had shrunk a little; the matrix stays symmetric). */
+static void drop_weak(struct mat *dst, const struct mat *src, double wmin)
+{
+    size_t nnz = (size_t)src->rowptr[src->n];
+    dst->n = src->n;
+    dst->rowptr = malloc((size_t)(src->n + 1) * sizeof *dst->rowptr);
+    dst->col = malloc(nnz * sizeof *dst->col);
+    dst->val = malloc(nnz * sizeof *dst->val);
+    dst->y = malloc((size_t)src->n * sizeof *dst->y);
+    memcpy(dst->y, src->y, (size_t)src->n * sizeof *dst->y);
+    int nz = 0;
+    dst->rowptr[0] = 0;
+    for (int i = 0; i < src->n; i++) {
+        for (int k = src->rowptr[i]; k < src->rowptr[i + 1]; k++)
+            if (src->col[k] == i || -src->val[k] >= wmin) {
+                dst->col[nz] = src->col[k];
+                dst->val[nz++] = src->val[k];
+            }
+        dst->rowptr[i + 1] = nz;
+    }
+    dst->csr = (struct fluid_csr){dst->n, dst->rowptr, dst->col, dst->val};
+}
+
+static void mat_free(struct mat *m)
+{
+    free(m->rowptr);
+    free(m->col);
+    free(m->val);
+    free(m->y);
+}
+
+static void spmv(const struct fluid_csr *A, const double *x, double *y)
+{
+    for (int i = 0; i < A->n; i++) {
+        double s = 0.0;
+        for (int k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+            s += A->val[k] * x[A->col[k]];
+        y[i] = s;
+    }
+}
+
+/* ||b - Ax|| / ||b||, computed here, not by the solver */
+static double relres(const struct fluid_csr *A, const double *b, const double *x)
+{
+    double *ax = malloc((size_t)A->n * sizeof *ax), rr = 0.0, bb = 0.0;
+    spmv(A, x, ax);
+    for (int i = 0; i < A->n; i++) {
+        rr += (b[i] - ax[i]) * (b[i] - ax[i]);
+        bb += b[i] * b[i];
+    }
+    free(ax);
+    return sqrt(rr / bb);
+}
+
+static double reldiff(int n, const double *x, const double *y)
+{
+    double d = 0.0, s = 0.0;
+    for (int i = 0; i < n; i++) {
+        d += (x[i] - y[i]) * (x[i] - y[i]);
+        s += y[i] * y[i];
+    }
+    return sqrt(d / s);
+}
+
+/* b = A p with p hydrostatic (depth below the surface) plus noise */
+static double *make_rhs(const struct mat *m, int ny)
+{
+    double *p = malloc((size_t)m->n * sizeof *p), *b = malloc((size_t)m->n * sizeof *b);
+    for (int i = 0; i < m->n; i++)
+        p[i] = (ny - 1 - m->y[i]) + 0.01 * urand();
+    spmv(&m->csr, p, b);
+    free(p);
+    return b;
+}
+
+static double *solve_new(const char *method, const struct mat *m, const double *b, double rtol,
+                         struct fluid_linsolve_stats *st)
+{
+    struct fluid_linsolve *s = NULL;
+    struct mps_err err = {0};
+    double *x = calloc((size_t)m->n, sizeof *x);
+    CHECK(fluid_linsolve_create(&s, method, rtol, 10000, 0, &err) == MPS_OK);
+    enum mps_status rc = fluid_linsolve_solve(s, &m->csr, b, x, st, &err);
+    if (rc)
+        fprintf(stderr, "%s: %s\n", method, err.msg);
+    CHECK(rc == MPS_OK);
+    fluid_linsolve_destroy(&s);
+    CHECK(s == NULL);
+    return x;
+}
+
+static void test_all_methods_solve_and_agree(void)
+{
+    const int nx = 60, ny = 60;
+    const double rtol = 1e-10;
+    struct mat m;
+    build(&m, nx, ny, 0.1, 0.0, 1e-6);
+    double *b = make_rhs(&m, ny);
+    printf("PPE test matrix: n = %d, nnz/row = %.1f\n", m.n, (double)m.rowptr[m.n] / m.n);
+    double *xs[NMETHODS];
+    for (int k = 0; k < NMETHODS; k++) {
+        struct fluid_linsolve_stats st;
+        xs[k] = solve_new(methods[k], &m, b, rtol, &st);
+        double res = relres(&m.csr, b, xs[k]);
+        printf("  %-14s iterations %4d  residual %.2e (own check %.2e)\n", methods[k],
+               st.iterations, st.residual, res);
+        CHECK(res <= rtol);
+        CHECK_NEAR(st.residual, res, 1e-3 * rtol);
+        if (!strncmp(methods[k], "pcg", 3))
+            CHECK(st.iterations > 0);
+        else if (strcmp(methods[k], "auto"))
+            CHECK(st.iterations == 0);
+    }
+    /* ||x - x*|| / ||x*|| <= cond(A) rtol; cond(A) is ~1e3 here, so 1e-6 is generous
+     * but still catches a solve of the wrong system. */
+    for (int k = 1; k < NMETHODS; k++)
+        CHECK(reldiff(m.n, xs[k], xs[2]) < 1e-6);
+
+    /* Warm start from the (direct) solution: at most one iteration. */
+    for (int k = 0; k < 2; k++) {
+        struct fluid_linsolve *s = NULL;
+        struct mps_err err = {0};
+        struct fluid_linsolve_stats st;
+        double *x = malloc((size_t)m.n * sizeof *x);
+        memcpy(x, xs[2], (size_t)m.n * sizeof *x);
+        CHECK(fluid_linsolve_create(&s, methods[k], rtol, 1000, 0, &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(st.iterations <= 1);
+        CHECK(relres(&m.csr, b, x) <= rtol);
+        /* Same solver object, cold start, on the same matrix: state reuse is harmless. */
+        memset(x, 0, (size_t)m.n * sizeof *x);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(st.iterations > 1);
+        CHECK(relres(&m.csr, b, x) <= rtol);
+        fluid_linsolve_destroy(&s);
+        free(x);
+    }
+    for (int k = 0; k < NMETHODS; k++)
+        free(xs[k]);
+    free(b);
+    mat_free(&m);
+}
+
+/* P A P^T with a random permutation: a numbering without locality. */
+static void scramble(struct mat *m)
+{
+    int n = m->n, nnz = m->rowptr[n];
+    int *perm = malloc((size_t)n * sizeof *perm), *inv = malloc((size_t)n * sizeof *inv);
+    for (int i = 0; i < n; i++)
+        perm[i] = i;
+    for (int i = n - 1; i > 0; i--) {
+        int k = (int)(urand() * (i + 1)), t = perm[i];
+        perm[i] = perm[k];
+        perm[k] = t;
+    }
+    for (int i = 0; i < n; i++)
+        inv[perm[i]] = i;   /* new row perm[i] is old row i */
+    int *rp = malloc((size_t)(n + 1) * sizeof *rp), *cl = malloc((size_t)nnz * sizeof *cl);
+    double *vl = malloc((size_t)nnz * sizeof *vl), *y = malloc((size_t)n * sizeof *y);
+    rp[0] = 0;
+    for (int r = 0; r < n; r++) {
+        int old = inv[r], lo = rp[r], len = m->rowptr[old + 1] - m->rowptr[old];
+        for (int k = 0; k < len; k++) {   /* insertion sort by new column */
+            int c = perm[m->col[m->rowptr[old] + k]], q = lo + k;
+            double v = m->val[m->rowptr[old] + k];
+            while (q > lo && cl[q - 1] > c) {
+                cl[q] = cl[q - 1];
+                vl[q] = vl[q - 1];
+                q--;
+            }
+            cl[q] = c;
+            vl[q] = v;
+        }
+        rp[r + 1] = lo + len;
+        y[r] = m->y[old];
+    }
+    mat_free(m);
+    *m = (struct mat){n, rp, cl, vl, y, {n, rp, cl, vl}};
+    free(perm);
+    free(inv);
+}
+
+/* 1 and 2 threads give the same answer; > 4096 rows, so the kernels run in
+ * parallel and pcg_ic0 factorises 2 blocks (natural numbering) or falls back
+ * to one (scrambled numbering, the split would drop half the couplings). */
+static void test_thread_counts_agree(void)
+{
+    for (int scr = 0; scr < 2; scr++) {
+        struct mat m;
+        build(&m, 80, 81, 0.1, 0.0, 1e-4);
+        if (scr)
+            scramble(&m);
+        double *b = make_rhs(&m, 81);
+        for (int k = 0; k < 2; k++) {
+            double *x[2];
+            int its[2];
+            for (int t = 0; t < 2; t++) {
+                struct fluid_linsolve *s = NULL;
+                struct mps_err err = {0};
+                struct fluid_linsolve_stats st;
+                x[t] = calloc((size_t)m.n, sizeof *x[t]);
+                CHECK(fluid_linsolve_create(&s, methods[k], 1e-9, 5000, t + 1, &err) == MPS_OK);
+                CHECK(fluid_linsolve_solve(s, &m.csr, b, x[t], &st, &err) == MPS_OK);
+                CHECK(relres(&m.csr, b, x[t]) <= 1e-9);
+                its[t] = st.iterations;
+                fluid_linsolve_destroy(&s);
+            }
+            printf("  %s, %s numbering: %d iterations with 1 thread, %d with 2\n", methods[k],
+                   scr ? "scrambled" : "lattice", its[0], its[1]);
+            CHECK(reldiff(m.n, x[1], x[0]) < 1e-6);
+            if (k == 0 || scr)   /* same preconditioner: same iterations up to rounding */
+                CHECK(abs(its[1] - its[0]) <= 2);
+            free(x[0]);
+            free(x[1]);
+        }
+        free(b);
+        mat_free(&m);
+    }
+}
+
+/* cholmod_reuse: the old ordering on a pattern subset (kept) and on moved
+ * particles (probably rejected as too much fill), the whole analysis kept for
+ * the same pattern, a fresh one when n changes; always the right answer. */
+static void test_cholmod_reuse_across_matrices(void)
+{
+    const double rtol = 1e-10;
+    struct mat m1, m1b, m2, m3;
+    build(&m1, 50, 40, 0.1, 0.0, 1e-6);
+    drop_weak(&m1b, &m1, 0.02);
+    CHECK(m1b.rowptr[m1b.n] < m1.rowptr[m1.n]);
+    build(&m2, 50, 40, 0.1, 0.4, 1e-6);   /* particles moved: same n, other pattern */
+    build(&m3, 45, 40, 0.1, 0.0, 1e-6);   /* fewer particles */
+    CHECK(m1.n == m2.n);
+    CHECK(m1.rowptr[m1.n] != m2.rowptr[m2.n] ||
+          memcmp(m1.col, m2.col, (size_t)m1.rowptr[m1.n] * sizeof(int)));
+    double *b1 = make_rhs(&m1, 40), *b2 = make_rhs(&m2, 40), *b3 = make_rhs(&m3, 40);
+    double *b1b = make_rhs(&m1b, 40);
+
+    struct fluid_linsolve *s = NULL;
+    struct mps_err err = {0};
+    struct fluid_linsolve_stats st;
+    CHECK(fluid_linsolve_create(&s, "cholmod_reuse", rtol, 1, 0, &err) == MPS_OK);
+    double *x = calloc((size_t)m1.n, sizeof *x);
+    const struct mat *seq[] = {&m1, &m1b, &m2, &m2, &m3, &m1};
+    const double *bs[] = {b1, b1b, b2, b2, b3, b1};
+    const int same = 3;   /* seq[same] repeats the previous pattern, with new values */
+    for (int k = 0; k < 6; k++) {
+        const struct mat *m = seq[k];
+        double *xref = solve_new("cholmod", m, bs[k], rtol, &st);
+        if (k == same)
+            for (int i = 0; i < m->rowptr[m->n]; i++)
+                m->val[i] *= 2.0;
+        CHECK(fluid_linsolve_solve(s, &m->csr, bs[k], x, &st, &err) == MPS_OK);
+        CHECK(relres(&m->csr, bs[k], x) <= rtol);
+        for (int i = 0; k == same && i < m->n; i++)
+            x[i] *= 2.0;   /* (2A) x = b  =>  x = x_ref / 2 */
+        CHECK(reldiff(m->n, x, xref) < 1e-8);
+        if (k == same)
+            CHECK(st.t_analyse == 0.0);
+        else
+            CHECK(st.t_analyse > 0.0);
+        if (k == same)
+            for (int i = 0; i < m->rowptr[m->n]; i++)
+                m->val[i] *= 0.5;
+        free(xref);
+    }
+    fluid_linsolve_destroy(&s);
+    free(x);
+    free(b1);
+    free(b2);
+    free(b3);
+    free(b1b);
+    mat_free(&m1);
+    mat_free(&m1b);
+    mat_free(&m2);
+    mat_free(&m3);
+}
+
+static void test_zero_rhs(void)
+{
+    struct mat m;
+    build(&m, 20, 20, 0.1, 0.0, 1e-6);
+    double *b = calloc((size_t)m.n, sizeof *b), *x = malloc((size_t)m.n * sizeof *x);
+    for (int k = 0; k < NMETHODS; k++) {
+        struct fluid_linsolve *s = NULL;
+        struct mps_err err = {0};
+        struct fluid_linsolve_stats st;
+        for (int i = 0; i < m.n; i++)
+            x[i] = 1.0 + i;
+        CHECK(fluid_linsolve_create(&s, methods[k], 1e-8, 100, 0, &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(st.iterations == 0);
+        double amax = 0.0;
+        for (int i = 0; i < m.n; i++)
+            amax = fmax(amax, fabs(x[i]));
+        CHECK(amax == 0.0);
+        fluid_linsolve_destroy(&s);
+    }
+    free(b);
+    free(x);
+    mat_free(&m);
+}
+
+static void test_errors(void)
+{
+    struct fluid_linsolve *s = NULL;
+    struct mps_err err = {0};
+    struct fluid_linsolve_stats st;
+
+    CHECK(fluid_linsolve_create(&s, "pcg_ilu", 1e-8, 100, 0, &err) == MPS_EINPUT);
+    CHECK(s == NULL);
+    CHECK(strstr(err.msg, "pcg_ilu") && strstr(err.msg, fluid_linsolve_methods()));
+    CHECK(fluid_linsolve_create(&s, "pcg_jacobi", 0.0, 100, 0, &err) == MPS_EINPUT);
+    CHECK(fluid_linsolve_create(&s, "pcg_jacobi", 1e-8, 0, 0, &err) == MPS_EINPUT);
+    CHECK(fluid_linsolve_create(&s, "pcg_jacobi", 1e-8, 10, -1, &err) == MPS_EINPUT);
+    fluid_linsolve_destroy(&s);   /* NULL is fine */
+    fluid_linsolve_destroy(NULL);
+
+    CHECK(fluid_linsolve_create(&s, "auto", 1e-8, 100, 0, &err) == MPS_OK);
+    CHECK(strcmp(fluid_linsolve_method(s), "auto") != 0);
+    CHECK(strstr(fluid_linsolve_methods(), fluid_linsolve_method(s)) != NULL);
+    fluid_linsolve_destroy(&s);
+
+    struct mat m;
+    build(&m, 30, 30, 0.1, 0.0, 1e-6);
+    double *b = make_rhs(&m, 30), *x = calloc((size_t)m.n, sizeof *x);
+
+    /* Hitting max_iter names the iterations and the residual reached. */
+    CHECK(fluid_linsolve_create(&s, "pcg_jacobi", 1e-10, 3, 0, &err) == MPS_OK);
+    CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_ESOLVE);
+    CHECK(strstr(err.msg, "did not converge in 3 iterations") != NULL);
+    CHECK(st.iterations == 3 && st.residual > 1e-10);
+    fluid_linsolve_destroy(&s);
+
+    for (int k = 0; k < NMETHODS; k++) {
+        CHECK(fluid_linsolve_create(&s, methods[k], 1e-8, 1000, 0, &err) == MPS_OK);
+        char row[32];
+        /* NaN in A (an off-diagonal entry of row 17) */
+        int pos = m.rowptr[17];
+        double keep = m.val[pos];
+        m.val[pos] = NAN;
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_ESOLVE);
+        CHECK(strstr(err.msg, "row 17") != NULL);
+        m.val[pos] = keep;
+        /* Inf in b */
+        keep = b[123];
+        b[123] = INFINITY;
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_ESOLVE);
+        snprintf(row, sizeof row, "row %d", 123);
+        CHECK(strstr(err.msg, row) != NULL);
+        b[123] = keep;
+        /* Still works after the errors */
+        memset(x, 0, (size_t)m.n * sizeof *x);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(relres(&m.csr, b, x) <= 1e-8);
+        fluid_linsolve_destroy(&s);
+    }
+
+    /* Row 1 without its diagonal: malformed input, named. */
+    int rpm[] = {0, 2, 4, 6}, clm[] = {0, 1, 0, 2, 1, 2};
+    double vlm[] = {2.0, -1.0, -1.0, -1.0, -1.0, 2.0}, bm[] = {1.0, 1.0, 1.0}, xm[3] = {0};
+    struct fluid_csr nodiag = {3, rpm, clm, vlm};
+    for (int k = 0; k < NMETHODS; k++) {
+        CHECK(fluid_linsolve_create(&s, methods[k], 1e-8, 100, 0, &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &nodiag, bm, xm, &st, &err) == MPS_EINPUT);
+        CHECK(strstr(err.msg, "row 1") && strstr(err.msg, "diagonal"));
+        fluid_linsolve_destroy(&s);
+    }
+
+    /* Singular matrix [1 1; 1 1]: every method reports it as a solver failure.
+     * (CHOLMOD's simplicial LDL' would solve an indefinite but nonsingular
+     * matrix without complaint; the PPE is SPD, so that is not checked.) */
+    int rp[] = {0, 2, 4}, cl[] = {0, 1, 0, 1};
+    double vl[] = {1.0, 1.0, 1.0, 1.0}, b2[] = {1.0, 0.0}, x2[2] = {0.0, 0.0};
+    struct fluid_csr sing = {2, rp, cl, vl};
+    for (int k = 0; k < NMETHODS; k++) {
+        CHECK(fluid_linsolve_create(&s, methods[k], 1e-8, 100, 0, &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &sing, b2, x2, &st, &err) == MPS_ESOLVE);
+        CHECK(strstr(err.msg, "not positive definite") != NULL);
+        /* and recovers on a good matrix */
+        memset(x, 0, (size_t)m.n * sizeof *x);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(relres(&m.csr, b, x) <= 1e-8);
+        fluid_linsolve_destroy(&s);
+    }
+    free(b);
+    free(x);
+    mat_free(&m);
+}
+
+int main(void)
+{
+    test_all_methods_solve_and_agree();
+    test_thread_counts_agree();
+    test_cholmod_reuse_across_matrices();
+    test_zero_rhs();
+    test_errors();
+    return test_summary("test_linsolve");
+}
