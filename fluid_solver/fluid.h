@@ -1,10 +1,14 @@
 /* The semi-implicit MPS fluid (paper 4.1, 4.3): state and one time step.
  * Particles are stored as a structure of arrays in three segments:
  *   [0, nfluid)            fluid
- *   [nfluid, nfixed_end)   tank wall (first layer, in the PPE) and dummy layers
+ *   [nfluid, nfixed_end)   tank wall (first layer) and dummy layers
  *   [nfixed_end, n)        solid particles given by a coupled solid (moving
- *                          boundary): surface ones in the PPE, inner ones only
- *                          in the number density. */
+ *                          boundary), surface and inner ones.
+ * Boundary pressure (fluid.wall_bc): with Neumann walls (default) only fluid
+ * particles are PPE unknowns and every boundary particle takes the fluid's
+ * pressure extrapolated hydrostatically; with the paper's walls the wall
+ * and solid surface particles are PPE unknowns and dummies carry none.
+ * docs/fluid.md describes the step and every deviation from the paper. */
 #ifndef FLUID_H
 #define FLUID_H
 
@@ -29,6 +33,7 @@ struct fluid {
     struct mps_particles ps;
     /* fields (registered in ps) */
     double (*x)[MPS_DIM];
+    double (*xref)[MPS_DIM];   /* positions when the neighbour list was built */
     double (*v)[MPS_DIM];
     double (*vstar)[MPS_DIM];
     double (*lap)[MPS_DIM];
@@ -69,6 +74,7 @@ struct fluid {
     double dt_last;
     long ppe_iterations;
     long nbr_rebuilds;
+    long lost;             /* fluid particles that splashed out of an open tank */
     struct mps_timer timer;
 };
 

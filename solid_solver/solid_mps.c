@@ -6,11 +6,13 @@
 
 #include "mps_kernel.h"
 #include "mps_nbr.h"
+#include "solid_mps_fracture.h"
 
-/* Below this many particles a step is too short for threads to pay off. */
-#define SOLID_MPS_OMP_MIN 4096
+static const char *const phase_names[SOLID_PH_N] = {"strain", "force", "update", "contact"};
 
-static const char *const phase_names[SOLID_PH_N] = {"strain", "force", "update"};
+/* The columns added to the case probes when fracture or contact is on. */
+static const char *const extra_probes[SOLID_MPS_NEXTRA] = {
+    "momentum_x", "momentum_y", "min_gap", "broken_bonds", "surface_particles"};
 
 static void register_fields(struct solid_mps *s)
 {
@@ -36,6 +38,8 @@ static void register_fields(struct solid_mps *s)
     mps_particles_add_field(ps, "id", 1, MPS_I32, (void **)&s->id, "", 1);
     mps_particles_add_field(ps, "body", 1, MPS_I32, (void **)&s->body, "", 1);
     mps_particles_add_field(ps, "surface", 1, MPS_U8, (void **)&s->surface, "", 1);
+    if (s->scene.eps_max > 0.0) /* fracture only: nothing allocated otherwise */
+        mps_particles_add_field(ps, "number_density", 1, MPS_F64, (void **)&s->nden, "", 1);
 }
 
 /* Fills the lattices: each body column by column if it is wider than tall
@@ -236,12 +240,20 @@ enum mps_status solid_mps_create(struct solid_mps **out, const struct solid_scen
         fill_bodies(s);
         st = build_bonds(s, err);
     }
+    if (st == MPS_OK)
+        st = solid_mps_frac_create(s, err);
+    for (int k = 0; st == MPS_OK && s->frac && k < scene->nprobes; k++)
+        for (int e = 0; e < SOLID_MPS_NEXTRA; e++)
+            if (strcmp(scene->probes[k].name, extra_probes[e]) == 0)
+                st = mps_err_set(err, MPS_EINPUT, "solid.probes.%d.name = %s: the name of a "
+                                 "column added under fracture or contact", k, extra_probes[e]);
     if (st != MPS_OK) {
         solid_mps_destroy(&s);
         return st;
     }
     find_probes(s);
-    mps_timer_init(&s->timer, phase_names, SOLID_PH_N);
+    int contact = s->frac && scene->contact != SOLID_CONTACT_NONE;
+    mps_timer_init(&s->timer, phase_names, contact ? SOLID_PH_N : SOLID_PH_CONTACT);
     *out = s;
     return MPS_OK;
 }
@@ -252,6 +264,7 @@ void solid_mps_destroy(struct solid_mps **sp)
         return;
     struct solid_mps *s = *sp;
     mps_particles_free(&s->ps);
+    solid_mps_frac_destroy(&s->frac);
     free(s->bstart);
     free(s->bj);
     free(s->br0);
@@ -331,7 +344,10 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
     const double spin = 3.0 / (s->dp * s->dp); /* rho V / (2 I), Eq. 43-44 */
 
     mps_timer_switch(&s->timer, SOLID_PH_STRAIN);
-    strain_pass(s);
+    if (s->nden)
+        solid_mps_frac_strain(s); /* Eq. 47-48 */
+    else
+        strain_pass(s);
 
     mps_timer_switch(&s->timer, SOLID_PH_FORCE);
 #pragma omp parallel for schedule(static) if (n >= SOLID_MPS_OMP_MIN)
@@ -352,6 +368,14 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
         v[i][0] += dt * (ax + gx + aload[i][0]); /* Eq. 39 */
         v[i][1] += dt * (ay + gy + aload[i][1]);
         omega[i] += dt * spin * tq; /* Eq. 45 */
+    }
+    if (s->frac && s->scene.contact != SOLID_CONTACT_NONE) {
+        mps_timer_switch(&s->timer, SOLID_PH_CONTACT);
+        enum mps_status st = solid_mps_frac_contact(s, dt, err);
+        if (st != MPS_OK) {
+            mps_timer_stop(&s->timer);
+            return st;
+        }
     }
 
     mps_timer_switch(&s->timer, SOLID_PH_UPDATE);
@@ -411,6 +435,7 @@ void solid_mps_diag(const struct solid_mps *s, struct solid_mps_diag *dg)
         }
         dg->elastic += 0.5 * m->lambda * tr * tr * V;
     }
+    dg->contact = solid_mps_frac_energy(s);
 }
 
 double solid_mps_probe(const struct solid_mps *s, int k)
@@ -471,8 +496,9 @@ static enum mps_status op_advance(void *self, double dt, struct mps_err *err)
     return solid_mps_advance(self, dt, err);
 }
 
-/* Surface particles (Eq. 48) and the particles within depth of one, found
- * once per depth on the initial lattice (bonds never change the topology). */
+/* Surface particles (Eq. 48) and the particles within depth of one, found on
+ * the initial lattice once per depth, and again when fracture made new
+ * surface particles (the inner ones near a crack are those near it in x0). */
 static enum mps_status build_iface(struct solid_mps *s, double depth, struct mps_err *err)
 {
     unsigned char *keep = calloc(s->n + 1, 1);
@@ -524,6 +550,7 @@ static enum mps_status build_iface(struct solid_mps *s, double depth, struct mps
             }
         s->iface_n = m;
         s->iface_depth = depth;
+        s->iface_rev = s->surface_rev;
     } else {
         s->iface_n = 0;
         s->iface_depth = -1.0;
@@ -536,7 +563,7 @@ static enum mps_status op_interface(void *self, double depth, struct solid_iface
                                     struct mps_err *err)
 {
     struct solid_mps *s = self;
-    if (depth != s->iface_depth) {
+    if (depth != s->iface_depth || s->iface_rev != s->surface_rev) {
         enum mps_status st = build_iface(s, depth, err);
         if (st != MPS_OK)
             return st;
@@ -554,19 +581,37 @@ static enum mps_status op_interface(void *self, double depth, struct solid_iface
     return MPS_OK;
 }
 
+/* Under fracture or contact the case probes are followed by extra_probes:
+ * total momentum (kg m/s per metre), the smallest distance between particles
+ * of different surfaces now (m, up to 2 dp), broken bonds, surface particles. */
 static int op_probe_count(const void *self)
 {
-    return ((const struct solid_mps *)self)->nprobes;
+    const struct solid_mps *s = self;
+    return s->nprobes + (s->frac ? SOLID_MPS_NEXTRA : 0);
 }
 
 static const char *op_probe_name(const void *self, int k)
 {
-    return ((const struct solid_mps *)self)->scene.probes[k].name;
+    const struct solid_mps *s = self;
+    return k < s->nprobes ? s->scene.probes[k].name : extra_probes[k - s->nprobes];
 }
 
 static double op_probe_value(const void *self, int k)
 {
-    return solid_mps_probe(self, k);
+    const struct solid_mps *s = self;
+    if (k < s->nprobes)
+        return solid_mps_probe(s, k);
+    struct solid_mps_diag d;
+    struct solid_mps_frac_stats st;
+    switch (k - s->nprobes) {
+    case 0:
+    case 1:
+        solid_mps_diag(s, &d);
+        return d.momentum[k - s->nprobes];
+    case 2: return solid_mps_min_gap(s, 2.0 * s->dp);
+    case 3: solid_mps_frac_stats(s, &st); return (double)st.broken;
+    default: solid_mps_frac_stats(s, &st); return (double)st.surface;
+    }
 }
 
 static size_t op_snapshot(void *self, const double (**x)[MPS_DIM], struct mps_field *fields,
@@ -604,6 +649,8 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_num(j, "momentum_y", d.momentum[1]);
     mps_json_num(j, "angular_momentum", d.angular);
     mps_json_close(j);
+    if (s->frac)
+        solid_mps_frac_summary(s, j);
     mps_json_object(j, "phase_seconds");
     for (int p = 0; p < s->timer.nphases; p++)
         mps_json_num(j, s->timer.names[p], s->timer.seconds[p]);

@@ -37,7 +37,10 @@
  * unstable (the bulk limit would be C = 0.76 at nu = 0.3). With this bound the
  * measured limit is C = 1.02-1.09 for bodies at least 3 particles thick and
  * 0.96 for a strip 2 particles thick (test_solid_stability); the default
- * solid.courant = 0.9 keeps every shape stable. */
+ * solid.courant = 0.9 keeps every shape stable.
+ *
+ * Brittle fracture and contact (section 4.4, solid.eps_max, solid.contact)
+ * are in solid_mps_fracture.h: off unless the scene asks, and then free. */
 #ifndef SOLID_MPS_H
 #define SOLID_MPS_H
 
@@ -55,13 +58,17 @@
 #define SOLID_MPS_RE 2.1        /* effective radius / dp (paper section 3) */
 #define SOLID_MPS_NC 0.5        /* surface if n0_i < n0_lattice - nc (Eq. 48) */
 #define SOLID_MPS_PROBE_MAX 8   /* particles averaged by one probe (ties) */
+#define SOLID_MPS_OMP_MIN 4096  /* below this many particles a step runs serial */
+#define SOLID_MPS_NEXTRA 5      /* probes added when fracture or contact is on */
 
 struct solid_mps_material {
     double rho, E, nu, lambda, mu;   /* kg/m^3, Pa, -, Pa, Pa */
     double wave_speed;               /* c_p, m/s */
 };
 
-enum solid_mps_phase { SOLID_PH_STRAIN, SOLID_PH_FORCE, SOLID_PH_UPDATE, SOLID_PH_N };
+/* contact last: timed (and summarised) only when contact is on */
+enum solid_mps_phase { SOLID_PH_STRAIN, SOLID_PH_FORCE, SOLID_PH_UPDATE, SOLID_PH_CONTACT,
+                       SOLID_PH_N };
 
 /* Fields are readable by tests and drivers; change them only through the API
  * (tests may set v and omega before the first step). */
@@ -81,7 +88,11 @@ struct solid_mps {
     double (*x0)[MPS_DIM], (*aload)[MPS_DIM], *n0;
     double *pressure, (*disp)[MPS_DIM]; /* filled for snapshots */
     int *id, *body;
-    unsigned char *fixed, *surface;
+    unsigned char *fixed;
+    unsigned char *surface;          /* Eq. 48, updated every step under fracture */
+    double *nden;                    /* n_i of the intact bonds; NULL without fracture */
+    long surface_rev;                /* +1 in each step that made new surface particles */
+    struct solid_mps_frac *frac;     /* fracture and contact state; NULL when off */
 
     /* bonds, CSR by particle (each pair stored from both ends); a broken
      * bond has bk = bb = bbr = 0 */
@@ -100,6 +111,7 @@ struct solid_mps {
 
     /* interface cache (solid_model_ops.interface) */
     double iface_depth;
+    long iface_rev;                  /* surface_rev the cache was built for */
     size_t iface_n;
     size_t *iface_idx;
     int *iface_id;
@@ -123,10 +135,11 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
 
 /* Diagnostics (per metre depth): linear momentum (kg m/s), angular momentum
  * about the origin including particle spin (kg m^2/s), and energies (J):
- * kinetic (translation + spin), elastic (bonds + volumetric), gravity. */
+ * kinetic (translation + spin), elastic (intact bonds + volumetric), gravity,
+ * contact (0 without contact). */
 struct solid_mps_diag {
     double momentum[MPS_DIM], angular;
-    double kinetic, elastic, gravity;
+    double kinetic, elastic, gravity, contact;
 };
 void solid_mps_diag(const struct solid_mps *s, struct solid_mps_diag *d);
 

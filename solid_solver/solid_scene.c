@@ -25,6 +25,14 @@ const struct mps_key_spec solid_case_keys[] = {
     {"solid.interface_depth", MPS_KEY_DOUBLE, "2.1", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
      "dp", "inner particles within this depth of the surface are sent to a coupled fluid (its "
      "number-density radius)"},
+    /* No defaults: a scene that sets neither has no fracture and no contact,
+     * and pays nothing for them (solid_mps_fracture.h, docs/fracture.md). */
+    {"solid.eps_max", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "",
+     "brittle fracture (Eq. 47): a bond breaks for good when its normal strain exceeds this; "
+     "absent: no fracture"},
+    {"solid.contact", MPS_KEY_ENUM, NULL, 0, 0, 0, "all|bodies|none", "",
+     "contact between unbonded surface particles: all (default with eps_max), bodies (only "
+     "between different bodies), none (default without eps_max)"},
     {"solid.bodies.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "body name, used by clamps"},
     {"solid.bodies.*.x0", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
@@ -126,6 +134,19 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
     s->courant = mps_case_double(c, "solid.courant");
     s->plane = strcmp(mps_case_string(c, "solid.plane"), "strain") == 0 ? SOLID_PLANE_STRAIN
                                                                           : SOLID_PLANE_STRESS;
+    s->eps_max = mps_case_has(c, "solid.eps_max") ? mps_case_double(c, "solid.eps_max") : 0.0;
+    s->contact = s->eps_max > 0.0 ? SOLID_CONTACT_ALL : SOLID_CONTACT_NONE;
+    if (mps_case_has(c, "solid.contact")) {
+        const char *v = mps_case_string(c, "solid.contact");
+        s->contact = strcmp(v, "all") == 0      ? SOLID_CONTACT_ALL
+                     : strcmp(v, "bodies") == 0 ? SOLID_CONTACT_BODIES
+                                                : SOLID_CONTACT_NONE;
+    }
+    if ((s->eps_max > 0.0 || s->contact != SOLID_CONTACT_NONE) &&
+        strcmp(mps_case_string(c, "solid.model"), "mps") != 0)
+        return mps_case_fail(c, err, s->eps_max > 0.0 ? "solid.eps_max" : "solid.contact",
+                             "fracture and contact are in the mps model only (solid.model = %s)",
+                             mps_case_string(c, "solid.model"));
 
     s->nbodies = mps_case_count(c, "solid.bodies");
     if (s->nbodies == 0)

@@ -19,6 +19,16 @@
  * a 2D beam bends with E itself (the paper's Eq. 53-54 assume E). */
 enum solid_plane { SOLID_PLANE_STRAIN, SOLID_PLANE_STRESS };
 
+/* Contact between solid surface particles not joined by an intact bond
+ * (paper section 4.4; force law in solid_mps_fracture.h):
+ *   NONE   no contact: bodies pass through each other;
+ *   BODIES only between particles of different bodies: the paper's run
+ *          "without contact detection" (Fig. 5 left), where the bodies still
+ *          collide but the faces of a crack in one body do not see each other;
+ *   ALL    also between the faces of cracks (bonds broken) and any other
+ *          unbonded pair of one body: the paper's contact detection. */
+enum solid_contact { SOLID_CONTACT_NONE, SOLID_CONTACT_BODIES, SOLID_CONTACT_ALL };
+
 enum solid_probe_kind {
     SOLID_PROBE_DX, /* x displacement, m */
     SOLID_PROBE_DY, /* y displacement, m */
@@ -49,6 +59,8 @@ struct solid_scene {
     double g[MPS_DIM];       /* body force per unit mass, m/s^2 */
     double courant;          /* (0, 1]: fraction of the stable step, see solid_mps.h */
     enum solid_plane plane;
+    double eps_max;          /* bond breaking strain (Eq. 47); 0: no fracture */
+    enum solid_contact contact;
     int nbodies, nclamps, nprobes;
     struct solid_body_def bodies[SOLID_MAX_BODIES];
     struct solid_clamp_def clamps[SOLID_MAX_CLAMPS];
