@@ -415,6 +415,29 @@ static inline void particle_F(const struct solid_tlsph *s, const double (*pg)[MP
     F[3] = fyy;
 }
 
+/* Quadratic mode: F (stress) and F_lin (hourglass) in one pass over the pairs. */
+static inline void particle_F2(const struct solid_tlsph *s, size_t i, double *F, double *Fl)
+{
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])s->x;
+    const double(*pg)[MPS_DIM] = (const double(*)[MPS_DIM])s->pg;
+    const double(*pgl)[MPS_DIM] = (const double(*)[MPS_DIM])s->pgl;
+    double xi = x[i][0], yi = x[i][1], f[4] = {0.0}, l[4] = {0.0};
+    for (size_t p = s->pstart[i]; p < s->pstart[i + 1]; p++) {
+        int j = s->pj[p];
+        double dx = x[j][0] - xi, dy = x[j][1] - yi;
+        f[0] += dx * pg[p][0];
+        f[1] += dx * pg[p][1];
+        f[2] += dy * pg[p][0];
+        f[3] += dy * pg[p][1];
+        l[0] += dx * pgl[p][0];
+        l[1] += dx * pgl[p][1];
+        l[2] += dy * pgl[p][0];
+        l[3] += dy * pgl[p][1];
+    }
+    memcpy(F, f, sizeof f);
+    memcpy(Fl, l, sizeof l);
+}
+
 void solid_tlsph_deform(struct solid_tlsph *s)
 {
     const size_t n = s->n;
@@ -423,10 +446,11 @@ void solid_tlsph_deform(struct solid_tlsph *s)
     const struct solid_tlsph_material *mat = s->mat;
 #pragma omp parallel for schedule(static) if (n >= SOLID_TLSPH_OMP_MIN)
     for (size_t i = 0; i < n; i++) {
-        particle_F(s, (const double(*)[MPS_DIM])s->pg, i, F[i]);
-        svk_pk1(F[i], mat[body[i]].lambda, mat[body[i]].mu, P[i]);
         if (s->quadratic)
-            particle_F(s, (const double(*)[MPS_DIM])s->pgl, i, s->Fl[i]);
+            particle_F2(s, i, F[i], s->Fl[i]);
+        else
+            particle_F(s, (const double(*)[MPS_DIM])s->pg, i, F[i]);
+        svk_pk1(F[i], mat[body[i]].lambda, mat[body[i]].mu, P[i]);
     }
 }
 

@@ -81,9 +81,7 @@
 #error "solid_tlsph: only MPS_DIM == 2 is implemented"
 #endif
 
-#define SOLID_TLSPH_HDP 1.3          /* smoothing length / dp (support 2.6 dp, 20 neighbours) */
-#define SOLID_TLSPH_ALPHA 1.0       /* default viscosity coefficient */
-#define SOLID_TLSPH_HG 0.05         /* default hourglass stiffness k_hg */
+#define SOLID_TLSPH_HDP 1.3         /* h / dp: support 2.6 dp, 20 neighbours */
 #define SOLID_TLSPH_VISC_CFL 0.6    /* viscous term of the stable step, see below */
 #define SOLID_TLSPH_QUAD_DT 0.55    /* step factor of the quadratic correction (measured) */
 #define SOLID_TLSPH_PROBE_MAX 8
