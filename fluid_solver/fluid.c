@@ -13,10 +13,12 @@
 static const char *const phase_names[PH_COUNT] = {
     "neighbours", "predict", "density", "ppe_assemble", "ppe_solve", "correct", "other"};
 
-/* Skin added to the Laplacian radius so one neighbour list, built at the start
- * of a step, serves the prediction and the positions after it; a step that
- * moves a particle by more than half the skin rebuilds the list. */
+/* Skin added to the Laplacian radius so one neighbour list serves several
+ * steps (a Verlet list): it is rebuilt once some particle has moved more
+ * than half the skin since the list was built. */
 #define SKIN_FRACTION 0.5
+/* Fluid particles are sorted by cell every this many list builds. */
+#define REORDER_EVERY 10
 
 static void register_fields(struct fluid *f)
 {
@@ -29,6 +31,7 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "number_density", 1, MPS_F64, (void **)&f->nd, "", 1);
     mps_particles_add_field(ps, "free_surface", 1, MPS_U8, (void **)&f->surface, "", 1);
     mps_particles_add_field(ps, "position", MPS_DIM, MPS_F64, (void **)&f->x, "m", 0);
+    mps_particles_add_field(ps, "x_list", MPS_DIM, MPS_F64, (void **)&f->xref, "m", 0);
     mps_particles_add_field(ps, "vstar", MPS_DIM, MPS_F64, (void **)&f->vstar, "m/s", 0);
     mps_particles_add_field(ps, "laplacian", MPS_DIM, MPS_F64, (void **)&f->lap, "", 0);
     mps_particles_add_field(ps, "grad_p", MPS_DIM, MPS_F64, (void **)&f->grad, "Pa/m", 0);
@@ -46,6 +49,27 @@ void fluid_update_masks(struct fluid *f)
         int t = f->type[i];
         f->is_fluid[i] = t == FLUID_P;
         f->has_p[i] = t == FLUID_P || t == WALL_P || t == SOLID_SURF_P;
+    }
+}
+
+/* Hydrostatic pressure at t = 0: rho |g_y| times the depth below the top
+ * particle of the water above (the free surface sits at the surface
+ * particles, where the PPE puts P = 0). Blocks are lattice-aligned boxes, so
+ * the top of the water at x is the highest block top covering x. */
+static void initial_pressure(struct fluid *f)
+{
+    const struct fluid_params *p = &f->prm;
+    for (size_t i = 0; i < f->nfluid; i++) {
+        double top = -INFINITY;
+        for (int b = 0; b < p->nblocks; b++) {
+            const double *bl = p->block[b];
+            double yt = bl[1] + (floor((bl[3] - bl[1]) / p->dp + 1e-6) - 0.5) * p->dp;
+            if (f->x[i][0] >= bl[0] && f->x[i][0] <= bl[2] && f->x[i][1] <= yt + p->dp && yt > top)
+                top = yt;
+        }
+        f->p[i] = isfinite(top) ? -p->rho * p->g[1] * (top - f->x[i][1]) : 0.0;
+        if (f->p[i] < 0.0)
+            f->p[i] = 0.0;
     }
 }
 
@@ -86,6 +110,8 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     free(pts);
     f->nfluid = nf;
     f->nfixed_end = nf + nw;
+    if (prm->initial_hydrostatic)
+        initial_pressure(f);
     fluid_update_masks(f);
 
     struct mps_lattice_consts cn = mps_lattice_consts(prm->dp, prm->re_n * prm->dp);
@@ -168,8 +194,42 @@ static enum mps_status build_neighbours(struct fluid *f, struct mps_err *err)
     if (st)
         return st;
     f->nbr_rebuilds++;
+    memcpy(f->xref, f->x, f->ps.n * sizeof *f->x);
     return mps_nbr_list_build(&f->nl, &f->grid, (const double(*)[MPS_DIM])f->x, f->ps.n, radius,
                               err);
+}
+
+static enum mps_status reorder_fluid(struct fluid *f, struct mps_err *err);
+
+/* Rebuilds the list if the particles changed (solid placed) or one of them
+ * moved more than half the skin since the last build; every REORDER_EVERY
+ * builds the fluid is sorted by cell first (if reorder is set). */
+static enum mps_status update_neighbours(struct fluid *f, int reorder, struct mps_err *err)
+{
+    const size_t n = f->ps.n;
+    int stale = f->nl.n != n || f->step == 0;
+    if (!stale) {
+        double m2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(max : m2)
+        for (size_t i = 0; i < n; i++) {
+            double d2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = f->x[i][d] - f->xref[i][d];
+                d2 += dx * dx;
+            }
+            if (d2 > m2)
+                m2 = d2;
+        }
+        stale = 4.0 * m2 > f->skin * f->skin;
+    }
+    if (!stale)
+        return MPS_OK;
+    if (reorder && f->nbr_rebuilds % REORDER_EVERY == 0 && f->grid.n == n) {
+        enum mps_status st = reorder_fluid(f, err);
+        if (st)
+            return st;
+    }
+    return build_neighbours(f, err);
 }
 
 /* Reorders the fluid segment by cell so neighbours sit close in memory. */
@@ -239,6 +299,165 @@ static void collide(struct fluid *f, double dt)
         }
 }
 
+/* Particle shifting (Lind et al. 2012, with Skillen et al. 2013's scaling and
+ * the free-surface treatment of the optimised scheme in the second paper):
+ * each fluid particle moves down the gradient of the number density,
+ *   dr_i = -A dp |v_i| dt grad n_i / n0,  grad n_i = sum_j w'(r_ij) e_ji,
+ * which spreads clusters and fills gaps (boundary particles count, so it also
+ * keeps particles off walls). On and next to the free surface only the part
+ * tangential to the surface is kept, n = -grad n / |grad n|, so the surface
+ * does not diffuse outwards. The step is capped at shift_max * dp. */
+static void shift(struct fluid *f, double dt)
+{
+    const struct fluid_params *p = &f->prm;
+    const double A = p->shift_coef, re = p->re_n * p->dp, re2 = re * re;
+    const double cap = p->shift_max * p->dp;
+    if (A <= 0.0)
+        return;
+    double(*dr)[MPS_DIM] = f->grad; /* scratch: grad is not needed any more */
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < f->nfluid; i++) {
+        double g[MPS_DIM] = {0}, sp2 = 0.0;
+        int near_surf = f->surface[i];
+        for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
+            int j = f->nl_n.j[k];
+            double dx[MPS_DIM], r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                dx[d] = f->x[j][d] - f->x[i][d];
+                r2 += dx[d] * dx[d];
+            }
+            if (r2 >= re2 || r2 <= 0.0)
+                continue;
+            double r = sqrt(r2), dw = re / r2; /* -w'(r) */
+            for (int d = 0; d < MPS_DIM; d++)
+                g[d] += dw * dx[d] / r; /* grad n_i = sum -w'(r) e_ij */
+            near_surf |= f->is_fluid[j] && f->surface[j];
+        }
+        for (int d = 0; d < MPS_DIM; d++)
+            sp2 += f->v[i][d] * f->v[i][d];
+        double s = -A * p->dp * sqrt(sp2) * dt / f->n0, d2 = 0.0;
+        double v[MPS_DIM];
+        for (int d = 0; d < MPS_DIM; d++)
+            v[d] = s * g[d];
+        if (near_surf) {
+            double gn = 0.0, vn = 0.0;
+            for (int d = 0; d < MPS_DIM; d++)
+                gn += g[d] * g[d];
+            gn = sqrt(gn);
+            if (gn > 0.0) {
+                for (int d = 0; d < MPS_DIM; d++)
+                    vn += v[d] * g[d] / gn;
+                for (int d = 0; d < MPS_DIM; d++)
+                    v[d] -= vn * g[d] / gn;
+            }
+        }
+        for (int d = 0; d < MPS_DIM; d++)
+            d2 += v[d] * v[d];
+        if (d2 > cap * cap) {
+            double sc = cap / sqrt(d2);
+            for (int d = 0; d < MPS_DIM; d++)
+                v[d] *= sc;
+        }
+        for (int d = 0; d < MPS_DIM; d++)
+            dr[i][d] = v[d];
+    }
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < f->nfluid; i++)
+        for (int d = 0; d < MPS_DIM; d++)
+            f->x[i][d] += dr[i][d];
+}
+
+/* Confirms the free-surface candidates of the double check (paper 4.3) by
+ * looking for empty space next to them (after Marrone et al. 2010's umbrella
+ * scan): with m_i = sum_j w_ij r_ij the weighted centroid direction of the
+ * neighbours and n = -m_i / |m_i|, the point T = x_i + dp n must be farther
+ * than surface_scan * dp from every neighbour (fluid or boundary). A
+ * candidate with a neighbour near T has no empty side: it sits at a small gap
+ * (next to a wall, or inside the water after particles rearranged) and keeps
+ * its PPE row. Without the scan such gaps get P = 0, which pulls the water
+ * apart further. */
+static void surface_scan(struct fluid *f)
+{
+    const double re = f->prm.re_n * f->prm.dp, re2 = re * re;
+    const double rs = f->prm.surface_scan * f->prm.dp, rs2 = rs * rs;
+#pragma omp parallel for schedule(dynamic, 64)
+    for (size_t i = 0; i < f->nfluid; i++) {
+        if (!f->surface[i])
+            continue;
+        double m[MPS_DIM] = {0};
+        for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
+            int j = f->nl_n.j[k];
+            double dx[MPS_DIM], r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                dx[d] = f->x[j][d] - f->x[i][d];
+                r2 += dx[d] * dx[d];
+            }
+            if (r2 >= re2 || r2 <= 0.0)
+                continue;
+            double w = mps_weight(sqrt(r2), re);
+            for (int d = 0; d < MPS_DIM; d++)
+                m[d] += w * dx[d];
+        }
+        double mn = 0.0;
+        for (int d = 0; d < MPS_DIM; d++)
+            mn += m[d] * m[d];
+        mn = sqrt(mn);
+        if (mn == 0.0)
+            continue; /* isolated or perfectly symmetric: keep the flag */
+        double t[MPS_DIM];
+        for (int d = 0; d < MPS_DIM; d++)
+            t[d] = f->x[i][d] - f->prm.dp * m[d] / mn;
+        int occupied = 0;
+        for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1] && !occupied; k++) {
+            int j = f->nl_n.j[k];
+            double r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                double dx = f->x[j][d] - t[d];
+                r2 += dx * dx;
+            }
+            occupied = r2 < rs2;
+        }
+        if (occupied)
+            f->surface[i] = 0;
+    }
+}
+
+/* Open tank: fluid particles that splashed out over a side wall (outside the
+ * walls, higher than the wall's thickness below its top, so clipping the top
+ * corner counts) leave the simulation and are counted in f->lost. A particle
+ * outside the walls lower down went through a wall: that stays an error
+ * (check_domain). */
+static enum mps_status remove_lost(struct fluid *f, struct mps_err *err)
+{
+    const struct fluid_params *p = &f->prm;
+    if (p->tank_lid)
+        return MPS_OK;
+    const double m = p->wall_layers * p->dp;
+    const size_t n = f->ps.n, nf = f->nfluid;
+    size_t nlost = 0;
+    for (size_t i = 0; i < nf; i++)
+        nlost += (f->x[i][0] < -m || f->x[i][0] > p->tank_w + m) && f->x[i][1] > p->tank_h - m;
+    if (nlost == 0)
+        return MPS_OK;
+    size_t *perm = malloc(n * sizeof *perm);
+    if (!perm)
+        return mps_err_set(err, MPS_ENOMEM, "fluid: out of memory removing lost particles");
+    size_t k = 0, l = n - nlost;
+    for (size_t i = 0; i < n; i++) {
+        int lost = i < nf && (f->x[i][0] < -m || f->x[i][0] > p->tank_w + m) &&
+                   f->x[i][1] > p->tank_h - m;
+        perm[lost ? l++ : k++] = i;
+    }
+    enum mps_status st = mps_particles_permute(&f->ps, perm, err);
+    free(perm);
+    if (st)
+        return st;
+    f->nfluid -= nlost;
+    f->nfixed_end -= nlost;
+    f->lost += (long)nlost;
+    return mps_particles_resize(&f->ps, n - nlost, err);
+}
+
 static enum mps_status check_domain(const struct fluid *f, struct mps_err *err)
 {
     const struct fluid_params *p = &f->prm;
@@ -274,15 +493,9 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
                            "flow is too fast for the CFL condition (Eq. 52)",
                            dt, f->time, p->dt_min);
 
-    /* neighbours at x^n (with skin), reordering the fluid now and then */
+    /* neighbours (Verlet list with skin), reordering the fluid now and then */
     mps_timer_switch(&f->timer, PH_NBR);
-    if (f->step % 20 == 0 && f->grid.n == n) {
-        st = reorder_fluid(f, err);
-        if (st)
-            return st;
-    }
-    st = build_neighbours(f, err);
-    if (st)
+    if ((st = update_neighbours(f, 1, err)))
         return st;
 
     /* Eq. 16-17: viscosity and gravity, explicit */
@@ -291,44 +504,46 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     if (p->nu > 0.0)
         mps_ops_laplacian_vec(&lap_in, f->n0_lap, f->lambda_lap,
                               (const double(*)[MPS_DIM])f->v, f->lap);
-    double maxdisp2 = 0.0;
-#pragma omp parallel for schedule(static) reduction(max : maxdisp2)
-    for (size_t i = 0; i < nf; i++) {
-        double d2 = 0.0;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < nf; i++)
         for (int d = 0; d < MPS_DIM; d++) {
             double visc = p->nu > 0.0 ? p->nu * f->lap[i][d] : 0.0;
             f->vstar[i][d] = f->v[i][d] + dt * (visc + p->g[d]);
-            double dx = dt * f->vstar[i][d];
-            f->x[i][d] += dx;
-            d2 += dx * dx;
+            f->x[i][d] += dt * f->vstar[i][d];
         }
-        if (d2 > maxdisp2)
-            maxdisp2 = d2;
-    }
     mps_timer_switch(&f->timer, PH_NBR);
-    if (2.0 * sqrt(maxdisp2) > f->skin && (st = build_neighbours(f, err)))
+    if ((st = update_neighbours(f, 0, err)))
         return st;
     if ((st = mps_nbr_list_filter(&f->nl_n, &f->nl, x, p->re_n * p->dp, err)))
         return st;
     mps_timer_switch(&f->timer, PH_PREDICT);
     collide(f, dt);
 
-    /* Eq. 8 at x*, and the free-surface double check (paper 4.3) */
+    /* Eq. 8 at x*, and the free-surface double check (paper 4.3), for the
+     * PPE unknowns: fluid (Neumann walls), or fluid, wall and solid surface */
     mps_timer_switch(&f->timer, PH_DENSITY);
-    struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, f->has_p};
+    const int neumann = p->wall_bc == FLUID_WALL_NEUMANN;
+    const unsigned char *rows = neumann ? f->is_fluid : f->has_p;
+    struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
     mps_ops_number_density(&nd_in, f->nd, f->ncount);
     const double nlim = p->beta1 * f->n0, clim = p->beta2 * f->count0;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++)
-        f->surface[i] = f->has_p[i] && f->nd[i] < nlim && f->ncount[i] < clim;
+        f->surface[i] = rows[i] && f->nd[i] < nlim && f->ncount[i] < clim;
+    if (p->surface_scan > 0.0)
+        surface_scan(f);
 
     if (p->mixed_source) {
-        /* Eq. 10 on v*: fixed particles have v* = 0, solid ones their velocity */
+        /* Eq. 10 on v*: fixed particles have v* = 0, solid ones their
+         * velocity. With Neumann walls the boundary also takes the kick
+         * dt g, since its extrapolated pressure holds the fluid against
+         * gravity: fluid at rest on a wall then has no divergence. */
+        const double kick = neumann ? dt : 0.0;
 #pragma omp parallel for schedule(static)
         for (size_t i = nf; i < n; i++)
             for (int d = 0; d < MPS_DIM; d++)
-                f->vstar[i][d] = f->v[i][d];
-        struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, f->has_p};
+                f->vstar[i][d] = f->v[i][d] + kick * p->g[d];
+        struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
         mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
     }
 
@@ -346,7 +561,10 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 
     /* Eq. 14-15 (or 9), Eq. 19 and 24 */
     mps_timer_switch(&f->timer, PH_CORRECT);
-    struct mps_ops_in g_in = {&f->nl_n, x, p->re_n * p->dp, f->has_p, f->is_fluid};
+    if (neumann)
+        fluid_ppe_boundary_pressure(f);
+    struct mps_ops_in g_in = {&f->nl_n, x, p->re_n * p->dp, neumann ? NULL : f->has_p,
+                              f->is_fluid};
     if (p->gradient == FLUID_GRAD_CORRECTED)
         mps_ops_gradient_corrected(&g_in, f->n0, f->p, p->gradient_min, 0.2, f->grad,
                                    f->fallback);
@@ -361,11 +579,16 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
             f->x[i][d] += dt * dv;
         }
 
+    shift(f, dt);
+    if (neumann)
+        fluid_ppe_boundary_clamp(f);
     mps_timer_switch(&f->timer, PH_OTHER);
     f->time += dt;
     f->step++;
     f->dt_last = dt;
-    st = check_domain(f, err);
+    st = remove_lost(f, err);
+    if (!st)
+        st = check_domain(f, err);
     mps_timer_stop(&f->timer);
     return st;
 }

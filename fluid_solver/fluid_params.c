@@ -20,6 +20,8 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
+    {"fluid.initial_pressure", MPS_KEY_ENUM, "hydrostatic", 0, 0, 0, "hydrostatic|zero", "",
+     "pressure at t = 0: hydrostatic below the top of the water above each particle, or zero"},
     {"fluid.alpha", MPS_KEY_DOUBLE, "1e-7", 0, 0, NOHI, NULL, "1/Pa",
      "compressibility 1/(rho c^2) of the weakly compressible PPE (Eq. 21-23)"},
     {"fluid.re_n", MPS_KEY_DOUBLE, "2.1", 1, 0, POS, NULL, "dp",
@@ -30,24 +32,40 @@ const struct mps_key_spec fluid_case_keys[] = {
      "free surface if n < beta1 n0 ..."},
     {"fluid.beta2", MPS_KEY_DOUBLE, "0.85", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "... and neighbour count < beta2 N0"},
+    {"fluid.surface_scan", MPS_KEY_DOUBLE, "1.15", 0, 1.4, 0, NULL, "dp",
+     "a free-surface candidate stays one only if no neighbour lies within this distance "
+     "of the point dp outside it (0: the paper's double check alone)"},
     {"fluid.gradient", MPS_KEY_ENUM, "corrected", 0, 0, 0, "corrected|plain", "",
      "pressure gradient: Eq. 14-15 (corrected) or Eq. 9 (plain)"},
-    {"fluid.gradient_min", MPS_KEY_BOOL, "true", 0, 0, 0, NULL, "",
+    {"fluid.wall_bc", MPS_KEY_ENUM, "neumann", 0, 0, 0, "neumann|ppe", "",
+     "wall pressure: Neumann condition by hydrostatic extrapolation from the fluid, or the "
+     "first wall layer solved in the PPE (paper 4.3), see docs/fluid.md"},
+    {"fluid.surface_laplacian", MPS_KEY_ENUM, "closed", 0, 0, 0, "closed|truncated", "",
+     "PPE Laplacian of the particles under the free surface (Neumann walls only): "
+     "neighbours missing beyond the surface extrapolated to P = 0 there (closed), or left "
+     "out as in the paper (truncated)"},
+    {"fluid.gradient_min", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
      "subtract the neighbourhood minimum pressure (repulsive pair terms only)"},
     {"fluid.clamp_negative", MPS_KEY_BOOL, "true", 0, 0, 0, NULL, "",
      "set negative PPE pressures to zero"},
-    {"fluid.collision_distance", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
+    {"fluid.collision_distance", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
      "fluid particles closer than this are pushed apart (0: off)"},
     {"fluid.collision_restitution", MPS_KEY_DOUBLE, "0.2", 0, 1, 0, NULL, "",
      "restitution of that collision"},
+    {"fluid.shifting", MPS_KEY_DOUBLE, "2.0", 0, 0, NOHI, NULL, "",
+     "particle shifting coefficient A of dr = -A dp |v| dt grad n / n0 (0: off)"},
+    {"fluid.shifting_max", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "dp",
+     "largest shift per step"},
     {"fluid.ppe_solver", MPS_KEY_ENUM, "auto", 0, 0, 0,
      "auto|pcg_jacobi|pcg_ic0|cholmod|cholmod_reuse", "", "linear solver for the PPE"},
     {"fluid.ppe_rtol", MPS_KEY_DOUBLE, "1e-6", 0, 0.1, MPS_KEY_LO_OPEN, NULL, "",
      "relative residual of iterative PPE solves"},
     {"fluid.ppe_max_iter", MPS_KEY_INT, "2000", 1, 0, NOHI, NULL, "", "iteration cap"},
-    {"fluid.tank.width", MPS_KEY_DOUBLE, NULL, 0, 0, POS | MPS_KEY_REQUIRED, NULL, "m",
+    /* not REQUIRED in the schema: a solid-only case has no tank; the fluid
+     * checks for it in fluid_params_read */
+    {"fluid.tank.width", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "m",
      "inner width of the tank (left wall inner face at x = 0)"},
-    {"fluid.tank.height", MPS_KEY_DOUBLE, NULL, 0, 0, POS | MPS_KEY_REQUIRED, NULL, "m",
+    {"fluid.tank.height", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "m",
      "inner height of the side walls (floor at y = 0)"},
     {"fluid.tank.lid", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "", "close the tank at the top"},
     {"fluid.tank.wall_layers", MPS_KEY_INT, "3", 3, 8, 0, NULL, "",
@@ -97,20 +115,34 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->kappa = mps_case_double(c, "fluid.kappa");
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
+    p->initial_hydrostatic =
+        strcmp(mps_case_string(c, "fluid.initial_pressure"), "hydrostatic") == 0;
     p->re_n = mps_case_double(c, "fluid.re_n");
     p->re_lap = mps_case_double(c, "fluid.re_lap");
     p->beta1 = mps_case_double(c, "fluid.beta1");
     p->beta2 = mps_case_double(c, "fluid.beta2");
+    p->surface_scan = mps_case_double(c, "fluid.surface_scan");
     p->gradient = strcmp(mps_case_string(c, "fluid.gradient"), "plain") == 0
                       ? FLUID_GRAD_PLAIN
                       : FLUID_GRAD_CORRECTED;
+    p->wall_bc = strcmp(mps_case_string(c, "fluid.wall_bc"), "ppe") == 0 ? FLUID_WALL_PPE
+                                                                           : FLUID_WALL_NEUMANN;
+    p->surface_closure = strcmp(mps_case_string(c, "fluid.surface_laplacian"), "closed") == 0 &&
+                         p->wall_bc == FLUID_WALL_NEUMANN;
     p->gradient_min = mps_case_bool(c, "fluid.gradient_min");
     p->clamp_negative = mps_case_bool(c, "fluid.clamp_negative");
     p->collision_dist = mps_case_double(c, "fluid.collision_distance");
     p->collision_restitution = mps_case_double(c, "fluid.collision_restitution");
+    p->shift_coef = mps_case_double(c, "fluid.shifting");
+    p->shift_max = mps_case_double(c, "fluid.shifting_max");
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");
     p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");
     p->ppe_max_iter = (int)mps_case_int(c, "fluid.ppe_max_iter");
+    if (!mps_case_has(c, "fluid.tank.width") || !mps_case_has(c, "fluid.tank.height"))
+        return mps_err_set(err, MPS_EINPUT, "%s: missing required key '%s' (the fluid needs a tank)",
+                           mps_case_path(c),
+                           mps_case_has(c, "fluid.tank.width") ? "fluid.tank.height"
+                                                                 : "fluid.tank.width");
     p->tank_w = mps_case_double(c, "fluid.tank.width");
     p->tank_h = mps_case_double(c, "fluid.tank.height");
     p->tank_lid = mps_case_bool(c, "fluid.tank.lid");

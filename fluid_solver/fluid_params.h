@@ -11,11 +11,18 @@
 
 enum fluid_gradient { FLUID_GRAD_CORRECTED, FLUID_GRAD_PLAIN };
 
+/* Pressure at fixed and solid boundaries: wall particles as PPE unknowns
+ * (paper 4.3), or a Neumann condition by hydrostatic extrapolation from the
+ * fluid (docs/fluid.md). */
+enum fluid_wall_bc { FLUID_WALL_NEUMANN, FLUID_WALL_PPE };
+
+
+
 enum fluid_probe_kind {
     FLUID_PROBE_FRONT,       /* x of the leading edge of the water on the floor, m */
     FLUID_PROBE_HEIGHT,      /* water height at x (default: the left wall), m */
     FLUID_PROBE_PRESSURE,    /* mean pressure of particles within 2 dp of (x, y), Pa */
-    FLUID_PROBE_BOTTOM,      /* mean pressure of the floor's wall particles under water, Pa */
+    FLUID_PROBE_BOTTOM,      /* pressure on the floor (y = 0) under water, Pa */
     FLUID_PROBE_MAX_SPEED,   /* max fluid speed, m/s */
     FLUID_PROBE_ESCAPED      /* fluid particles outside the tank, count */
 };
@@ -31,14 +38,19 @@ struct fluid_params {
     double rho, nu;
     double courant, dt_max, dt_min;
     int mixed_source;             /* add the velocity-divergence source term */
+    int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
     double re_n, re_lap;          /* effective radii, multiples of dp */
     double beta1, beta2;          /* free-surface double check */
+    double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */
     enum fluid_gradient gradient;
+    enum fluid_wall_bc wall_bc;
+    int surface_closure;          /* close the PPE Laplacian under the free surface */
     int gradient_min;             /* subtract the neighbourhood minimum pressure */
     int clamp_negative;           /* negative PPE pressures set to 0 */
     double collision_dist;        /* fraction of dp; 0 = off */
     double collision_restitution;
+    double shift_coef, shift_max; /* particle shifting: A (0 = off), cap in dp */
     const char *ppe_solver;
     double ppe_rtol;
     int ppe_max_iter;

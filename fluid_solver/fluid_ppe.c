@@ -19,28 +19,59 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     return 0;
 }
 
-/* Pass 1 for row particle i: caches c w_ij in f->wlap for the Laplacian
- * neighbours that carry a pressure (0 for the others), returns the number of
- * unknown neighbours and their summed weight in *diag. */
+/* Pass 1 for row particle i: caches c w_ij in f->wlap for every Laplacian
+ * neighbour that enters row i (0 for the others), returns the number of
+ * unknown neighbours and the diagonal in *diag.
+ * Paper walls (4.3): the neighbours that carry a pressure (fluid, wall, solid
+ * surface); dummy particles are left out.
+ * Neumann walls: fluid neighbours enter as unknowns (or P = 0 on the free
+ * surface); boundary neighbours (wall, dummy, solid) take the pressure
+ * P_j = P_i + rho g.(x_j - x_i), so their P_i - P_j is known and goes to
+ * the right-hand side (pass 2), not to the diagonal. */
 static int row_weights(struct fluid *f, size_t i, double c, double *diag)
 {
     const double re = f->prm.re_lap * f->prm.dp, re2 = re * re;
+    const int neumann = f->prm.wall_bc == FLUID_WALL_NEUMANN;
     int m = 0;
-    double dsum = 0.0;
+    double dsum = 0.0, mom[2] = {0.0, 0.0}, srf[2] = {0.0, 0.0}, ws = 0.0;
     for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
         int j = f->nl.j[k];
         double cw = 0.0;
-        if (f->has_p[j]) {
+        if (neumann || f->has_p[j]) {
             double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
             double r2 = dx * dx + dy * dy;
             if (r2 < re2) {
                 cw = c * mps_weight(sqrt(r2), re);
-                dsum += cw;
-                /* same predicate as pass 2: r == re rounds to w = 0 */
-                m += cw > 0.0 && f->row[j] >= 0;
+                if (!neumann || f->is_fluid[j]) {
+                    dsum += cw;
+                    /* same predicate as pass 2: r == re rounds to w = 0 */
+                    m += cw > 0.0 && f->row[j] >= 0;
+                }
+                mom[0] += cw * dx;
+                mom[1] += cw * dy;
+                if (f->is_fluid[j] && f->surface[j]) {
+                    srf[0] += cw * dx;
+                    srf[1] += cw * dy;
+                    ws += cw;
+                }
             }
         }
         f->wlap[k] = cw;
+    }
+    double mn = sqrt(mom[0] * mom[0] + mom[1] * mom[1]);
+    if (neumann && f->prm.surface_closure && ws > 0.0 && mn > 0.0) {
+        /* Free-surface closure: the neighbours missing beyond the free surface
+         * would contribute sum_missing c w (P_j - P_i) = -grad P . m_i for a
+         * linear field, with m_i = sum_present c w r_ij (the full lattice sums
+         * to zero). With grad P = -(P_i / h_i) n, n = -m_i / |m_i| the outward
+         * normal and h_i the mean depth of i below its surface neighbours
+         * (where P = 0), that is -(|m_i| / h_i) P_i: a diagonal term, so the
+         * matrix stays symmetric. Exact for a flat surface under hydrostatic
+         * pressure; left out, the truncated sum acts as a zero-flux wall and
+         * lifts the pressure of the layers under the surface. */
+        const double hmin = 0.5 * f->prm.dp;
+        double h = -(srf[0] * mom[0] + srf[1] * mom[1]) / (ws * mn);
+        dsum += mn / (h > hmin ? h : hmin);
     }
     *diag = dsum;
     return m;
@@ -51,8 +82,9 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     const struct fluid_params *p = &f->prm;
     const size_t n = f->ps.n;
     int nrows = 0;
+    const int neumann = p->wall_bc == FLUID_WALL_NEUMANN;
     for (size_t i = 0; i < n; i++)
-        f->row[i] = (f->has_p[i] && !f->surface[i]) ? nrows++ : -1;
+        f->row[i] = ((neumann ? f->is_fluid[i] : f->has_p[i]) && !f->surface[i]) ? nrows++ : -1;
     f->nrows = nrows;
 
     size_t rcap = f->cap_rows;
@@ -101,11 +133,20 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         int *cols = f->col + s;
         double *vals = f->val + s, diag = f->rhs[r];
         int q = 1;
+        double ghost = 0.0;
         for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
             int j = f->nl.j[k];
-            if (f->wlap[k] != 0.0 && f->row[j] >= 0) {
+            if (f->wlap[k] == 0.0)
+                continue;
+            if (f->row[j] >= 0) {
                 cols[q] = f->row[j];
                 vals[q++] = -f->wlap[k];
+            } else if (neumann && !f->is_fluid[j]) {
+                /* c w_ij (P_j - P_i) = c w_ij rho g.(x_j - x_i), to the right */
+                double gx = 0.0;
+                for (int d = 0; d < MPS_DIM; d++)
+                    gx += p->g[d] * (f->x[j][d] - f->x[i][d]);
+                ghost += f->wlap[k] * p->rho * gx;
             }
         }
         int k = 0;
@@ -116,7 +157,12 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         }
         cols[k] = r;
         vals[k] = diag + comp;
-        f->rhs[r] = src * (f->nd[i] - f->n0) - (mixed ? f->div[i] * div_coef : 0.0);
+        /* Eq. 23's density term */
+        double dn = f->nd[i] - f->n0;
+        f->rhs[r] = ghost + src * dn;
+        if (mixed) /* with Neumann walls compressibility acts on the change of
+                    * pressure, see fluid_ppe.h */
+            f->rhs[r] += (neumann ? comp * f->p[i] : 0.0) - f->div[i] * div_coef;
         f->sol[r] = f->p[i]; /* warm start */
     }
     return MPS_OK;
@@ -142,6 +188,53 @@ enum mps_status fluid_ppe_solve(struct fluid *f, struct fluid_linsolve_stats *st
         f->p[i] = (clamp && pi < 0.0) ? 0.0 : pi;
     }
     return st;
+}
+
+void fluid_ppe_boundary_pressure(struct fluid *f)
+{
+    const struct fluid_params *p = &f->prm;
+    const double re = (p->re_n + 1.0) * p->dp, re2 = re * re;
+    const size_t n = f->ps.n;
+    /* Adami, Hu & Adams (2012): P_b = sum_f w (P_f + rho g.(x_b - x_f)) / sum_f w,
+     * the hydrostatic extrapolation of the fluid pressures around b. Only the
+     * gradient uses P_b (the PPE extrapolates from each row particle itself),
+     * and it reaches the wall layer and the next one: a radius of re_n + dp
+     * lets both see two rows of fluid. A wider one (re_lap) spreads impact
+     * pressures along the wall and pushes the water off it (measured:
+     * dam-break runs failed sooner, docs/fluid.md). */
+#pragma omp parallel for schedule(static)
+    for (size_t b = f->nfluid; b < n; b++) {
+        double s = 0.0, ws = 0.0;
+        for (size_t k = f->nl.start[b]; k < f->nl.start[b + 1]; k++) {
+            int j = f->nl.j[k];
+            if (!f->is_fluid[j])
+                continue;
+            double dx[MPS_DIM], r2 = 0.0, gx = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                dx[d] = f->x[b][d] - f->x[j][d];
+                r2 += dx[d] * dx[d];
+                gx += p->g[d] * dx[d];
+            }
+            if (r2 >= re2)
+                continue;
+            double w = mps_weight(sqrt(r2), re);
+            s += w * (f->p[j] + p->rho * gx);
+            ws += w;
+        }
+        /* not clamped: above the water line this is the linear extension
+         * the PPE assumed; fluid_ppe_boundary_clamp() clamps after use */
+        f->p[b] = ws > 0.0 ? s / ws : 0.0;
+        f->surface[b] = ws == 0.0; /* dry: no fluid within reach */
+    }
+}
+
+void fluid_ppe_boundary_clamp(struct fluid *f)
+{
+    if (!f->prm.clamp_negative)
+        return;
+    for (size_t b = f->nfluid; b < f->ps.n; b++)
+        if (f->p[b] < 0.0)
+            f->p[b] = 0.0;
 }
 
 enum mps_status fluid_ppe_dump(const struct fluid *f, const char *matrix_path,

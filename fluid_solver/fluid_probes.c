@@ -45,13 +45,15 @@ static double probe_pressure(const struct fluid *f, double x, double y)
 static double probe_bottom(const struct fluid *f)
 {
     /* mean over floor wall particles that have water above them (not free
-     * surface): the pressure on the bottom of the tank */
+     * surface) of their pressure carried hydrostatically from the particle
+     * centre (dp/2 below the floor) up to the floor, y = 0: the pressure on
+     * the bottom of the tank */
     double s = 0.0;
     int m = 0;
     for (size_t i = f->nfluid; i < f->nfixed_end; i++)
         if (f->type[i] == WALL_P && f->x[i][1] < 0.0 && f->x[i][0] > 0.0 &&
             f->x[i][0] < f->prm.tank_w && !f->surface[i]) {
-            s += f->p[i];
+            s += f->p[i] + f->prm.rho * f->prm.g[1] * (0.0 - f->x[i][1]);
             m++;
         }
     return m ? s / m : 0.0;
@@ -114,6 +116,7 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
     mps_json_int(j, "ppe_iterations", f->ppe_iterations);
     mps_json_num(j, "ppe_iterations_per_step", f->step ? (double)f->ppe_iterations / f->step : 0);
     mps_json_int(j, "neighbour_builds", f->nbr_rebuilds);
+    mps_json_int(j, "lost_particles", f->lost);
     mps_json_str(j, "ppe_solver", fluid_linsolve_method(f->ls));
     double total = mps_timer_total(&f->timer);
     mps_json_num(j, "step_seconds", total);

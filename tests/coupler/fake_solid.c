@@ -75,7 +75,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
             s->id[k] = (int)k;
             s->x0[k][0] = b[0] + (i + 0.5) * s->dp;
             s->x0[k][1] = b[1] + (j + 0.5) * s->dp;
-            s->surface[k] = i == 0 || j == 0 || i == nx - 1 || j == ny - 1;
+            /* the bottom row stands on the floor: no water reaches it */
+            s->surface[k] = j > 0 && (i == 0 || i == nx - 1 || j == ny - 1);
         }
     place(s, 0.0);
     (void)out;

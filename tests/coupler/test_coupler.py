@@ -116,8 +116,9 @@ def t_solid_hang():
 
 def t_fluid_killed():
     out = tempfile.mkdtemp(prefix='cpl_kill_')
-    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid'],
-                         stderr=subprocess.PIPE, text=True)
+    # long enough that it is still running when we strike
+    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                          '--set', 'end_time=20'], stderr=subprocess.PIPE, text=True)
     pid = None
     for _ in range(300):
         time.sleep(0.1)
@@ -138,8 +139,9 @@ def t_fluid_killed():
 
 def t_interrupt():
     out = tempfile.mkdtemp(prefix='cpl_int_')
-    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid'],
-                         stderr=subprocess.PIPE, text=True)
+    # long enough that it is still running when we strike
+    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                          '--set', 'end_time=20'], stderr=subprocess.PIPE, text=True)
     for _ in range(300):
         time.sleep(0.1)
         if os.path.exists(os.path.join(out, 'probes.csv')) and len(probes(out)) > 3:

@@ -1,0 +1,26 @@
+# The coupled dam break on an elastic plate at a coarse spacing (6 mm: the
+# plate is 2 particles thick) to 0.4 s: the plate must deflect downstream with
+# its first peak near the published band (0.041-0.049 m at 0.22-0.26 s, eleven
+# methods). Band for this resolution: a 2-row plate has 0.75 of the bending
+# stiffness of b^3/12 (more deflection) and the coarse water front is blunter
+# (less impulse), so the check allows about 25% either side of the published
+# band, 0.031-0.061 m, and 0.18-0.32 s for the time of the peak.
+add_test(NAME coupled_dambreak_plate_coarse
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6 --quiet --set dp=0.006 --set end_time=0.4 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 0.4 --peak-band 0.031 0.061 --peak-time 0.18 0.32"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupled_dambreak_plate_coarse PROPERTIES TIMEOUT 300 LABELS validation)
+
+# The elastic gate (issue 6) at a coarse spacing with each solid model to 0.2 s:
+# the gate must open downstream (the free end moves right and up).
+foreach(model mps tlsph)
+  add_test(NAME coupled_elastic_gate_${model}
+           COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/elastic_gate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/gate_${model} --quiet --set dp=0.0025 --set end_time=0.12 --solid 'solid_solver --model ${model}' && /usr/bin/python3 tests/coupler/gate_check.py ${CMAKE_BINARY_DIR}/test_out/gate_${model}"
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(coupled_elastic_gate_${model} PROPERTIES TIMEOUT 300 LABELS validation)
+endforeach()
+
+# A third-party solid (Python, proto/PROTOCOL.md only) in a coupled run.
+add_test(NAME coupled_python_modal_solid
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler tests/coupler/plate_in_water.yml --out ${CMAKE_BINARY_DIR}/test_out/pymodal --quiet --set end_time=0.3 --solid '/usr/bin/python3 solid_solver/python/modal_beam_solid.py' && /usr/bin/python3 tests/coupler/modal_check.py ${CMAKE_BINARY_DIR}/test_out/pymodal"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupled_python_modal_solid PROPERTIES TIMEOUT 120 LABELS integration)

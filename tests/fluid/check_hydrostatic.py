@@ -1,0 +1,62 @@
+#!/usr/bin/python3
+"""Checks a hydrostatic run (cases/hydrostatic) against the issue's targets.
+
+usage: check_hydrostatic.py RUN_DIR [--depth 0.3] [--rho 1000] [--g 9.81]
+                            [--p-tol 0.03] [--v-frac 0.01] [--t-end 2.0]
+From RUN_DIR/probes.csv and summary.json:
+  - the run finished (status ok, simulated time >= t-end);
+  - bottom_pressure (pressure on the floor, Pa) within p-tol of rho g h at every
+    probe time after the first (t > 0), and on average;
+  - max_speed below v-frac * sqrt(g h) at every probe time;
+  - escaped == 0 at every probe time.
+Exit 0 if all hold, 1 otherwise; prints what it measured."""
+import argparse, csv, json, math, os, sys
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('run')
+    ap.add_argument('--depth', type=float, default=0.3)
+    ap.add_argument('--rho', type=float, default=1000.0)
+    ap.add_argument('--g', type=float, default=9.81)
+    ap.add_argument('--p-tol', type=float, default=0.03)
+    ap.add_argument('--v-frac', type=float, default=0.01)
+    ap.add_argument('--t-end', type=float, default=2.0)
+    a = ap.parse_args()
+    with open(os.path.join(a.run, 'summary.json')) as f:
+        summ = json.load(f)
+    with open(os.path.join(a.run, 'probes.csv')) as f:
+        rows = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(f)]
+    p_ref = a.rho * a.g * a.depth
+    v_lim = a.v_frac * math.sqrt(a.g * a.depth)
+    later = [r for r in rows if r['time'] > 0.0]
+    bad = []
+    if summ.get('status') != 'ok' or summ.get('simulated_time', 0.0) < a.t_end - 1e-9:
+        bad.append(f"run did not finish: status {summ.get('status')}, t = "
+                   f"{summ.get('simulated_time')} s: {summ.get('message')}")
+    if not later:
+        bad.append('no probe rows after t = 0')
+    else:
+        perr = [r['bottom_pressure'] / p_ref - 1.0 for r in later]
+        worst = max(perr, key=abs)
+        mean = sum(r['bottom_pressure'] for r in later) / len(later) / p_ref - 1.0
+        vmax = max(r['max_speed'] for r in rows)
+        tv = max(rows, key=lambda r: r['max_speed'])['time']
+        esc = max(r['escaped'] for r in rows)
+        print(f"bottom pressure: mean {100 * mean:+.2f}%, worst {100 * worst:+.2f}% of rho g h = "
+              f"{p_ref:.1f} Pa (tolerance {100 * a.p_tol:.0f}%)")
+        print(f"max speed {vmax:.5f} m/s at t = {tv:.3f} s (limit {v_lim:.5f} m/s = "
+              f"{a.v_frac:g} sqrt(g h)); escaped particles: {esc:.0f}")
+        if abs(worst) > a.p_tol or abs(mean) > a.p_tol:
+            bad.append('bottom pressure out of tolerance')
+        if vmax >= v_lim:
+            bad.append('water not still')
+        if esc > 0:
+            bad.append('particles left the tank')
+    for b in bad:
+        print('FAIL:', b)
+    sys.exit(1 if bad else 0)
+
+
+if __name__ == '__main__':
+    main()

@@ -1,0 +1,185 @@
+/* One fluid step against known answers (fluid.c, fluid_ppe.c):
+ *   - still water: with Neumann walls and the closed free-surface Laplacian
+ *     the PPE returns the hydrostatic pressure of the lattice exactly and the
+ *     water stays still (cases/hydrostatic);
+ *   - first step of the dam break, incompressible (alpha = 0): the pressure
+ *     of the potential-flow problem at t = 0 (Laplace, P = 0 on the free
+ *     faces, dP/dn = rho g.n on the walls), reference from a finite-difference
+ *     solve below;
+ *   - the paper's walls (fluid.wall_bc = ppe) still run;
+ *   - the Verlet neighbour list holds every pair within re_lap while no
+ *     particle has moved half the skin since it was built. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include "../test_util.h"
+#include "fluid.h"
+#include "mps_case.h"
+
+static struct fluid *make(const char *path, const char **sets, int nsets)
+{
+    struct mps_err err = {0};
+    struct mps_case *cs = NULL;
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys};
+    const char *const ignore[] = {"solid.", "coupling.", NULL};
+    if (mps_case_load(&cs, path, sets, nsets, tables, 2, ignore, &err)) {
+        fprintf(stderr, "%s\n", err.msg);
+        return NULL;
+    }
+    struct fluid_params prm;
+    struct fluid *f = NULL;
+    if (fluid_params_read(&prm, cs, &err) || fluid_create(&f, &prm, &err))
+        fprintf(stderr, "%s\n", err.msg);
+    /* prm keeps pointers into the case (strings): the case must outlive f;
+     * tests are short, leak it on purpose */
+    return f;
+}
+
+static int step(struct fluid *f, double dt)
+{
+    struct mps_err err = {0};
+    enum mps_status st = fluid_step(f, dt, &err);
+    if (st)
+        fprintf(stderr, "fluid_step: %s\n", err.msg);
+    return st;
+}
+
+static size_t nearest_fluid(const struct fluid *f, double x, double y)
+{
+    size_t best = 0;
+    double d2 = INFINITY;
+    for (size_t i = 0; i < f->nfluid; i++) {
+        double dx = f->x[i][0] - x, dy = f->x[i][1] - y;
+        if (dx * dx + dy * dy < d2) {
+            d2 = dx * dx + dy * dy;
+            best = i;
+        }
+    }
+    return best;
+}
+
+static void test_still_water(void)
+{
+    const char *sets[] = {"dp=0.01"};
+    struct fluid *f = make("cases/hydrostatic/case.yml", sets, 1);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    /* the surface particles' centres are at y = 0.295 (P = 0 there) */
+    const double rho = 1000.0, g = 9.81, ys = 0.3 - 0.5 * 0.01;
+    double eps = 0.0, vmax = 0.0, xe = 0.0, ye = 0.0;
+    for (int k = 0; k < 10; k++)
+        CHECK(step(f, 1e-3) == MPS_OK);
+    for (size_t i = 0; i < f->nfluid; i++) {
+        double want = rho * g * (ys - f->x[i][1]);
+        if (fabs(f->p[i] - want) > eps) {
+            eps = fabs(f->p[i] - want);
+            xe = f->x[i][0];
+            ye = f->x[i][1];
+        }
+        vmax = fmax(vmax, hypot(f->v[i][0], f->v[i][1]));
+    }
+    printf("still water, 10 steps: |P - rho g (h - y)| <= %.3g Pa (at %.3f, %.3f), max speed "
+           "%.2e m/s\n", eps, xe, ye, vmax);
+    /* measured 2.7 Pa (at the bottom corners) of 2900 Pa at the floor, and
+     * 1.2e-3 m/s; the issue's target is 0.0172 m/s over 2 s */
+    CHECK(eps < 5.0);
+    CHECK(vmax < 2e-3);
+    fluid_destroy(&f);
+    CHECK(f == NULL);
+}
+
+static void test_dambreak_first_step(void)
+{
+    /* Finite-difference solution (280 x 568 cells, second order) of the
+     * incompressible t = 0 problem on the region the particles span at
+     * dp = 8 mm: 0 < x < 0.140 (P = 0 at the right column's centres),
+     * 0 < y < 0.284 (P = 0 at the top row's centres), dP/dx = 0 on the left
+     * wall, dP/dy = -rho g on the floor. Pressures in Pa. */
+    static const double ref[4][3] = {
+        {0.004, 0.004, 976.7}, {0.004, 0.140, 220.6}, {0.068, 0.004, 807.7}, {0.068, 0.140, 161.1}};
+    const char *sets[] = {"dp=0.008", "fluid.alpha=0", "fluid.ppe_rtol=1e-9"};
+    struct fluid *f = make("cases/dambreak/case.yml", sets, 3);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    CHECK(step(f, 1e-3) == MPS_OK);
+    for (int k = 0; k < 4; k++) {
+        size_t i = nearest_fluid(f, ref[k][0], ref[k][1]);
+        double e = f->p[i] / ref[k][2] - 1.0;
+        printf("dam break t = 0: P(%.3f, %.3f) = %.1f Pa, potential flow %.1f Pa (%+.1f%%)\n",
+               ref[k][0], ref[k][1], f->p[i], ref[k][2], 100.0 * e);
+        CHECK(fabs(e) < 0.06);
+    }
+    fluid_destroy(&f);
+}
+
+static void test_paper_walls(void)
+{
+    const char *sets[] = {"dp=0.02", "fluid.wall_bc=ppe", "fluid.ppe_source=density"};
+    struct fluid *f = make("cases/hydrostatic/case.yml", sets, 3);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    for (int k = 0; k < 5; k++)
+        CHECK(step(f, 1e-3) == MPS_OK);
+    double pmax = 0.0;
+    for (size_t i = 0; i < f->ps.n; i++)
+        pmax = fmax(pmax, f->p[i]);
+    printf("paper walls, 5 steps: max pressure %.0f Pa\n", pmax);
+    CHECK(isfinite(pmax) && pmax > 0.0);
+    fluid_destroy(&f);
+}
+
+static void test_verlet_list(void)
+{
+    const char *sets[] = {"dp=0.008"};
+    struct fluid *f = make("cases/dambreak/case.yml", sets, 1);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    const double re = f->prm.re_lap * f->prm.dp;
+    int checked = 0;
+    long builds0 = 0;
+    for (int k = 0; k < 120; k++) {
+        CHECK(step(f, fluid_cfl_dt(f)) == MPS_OK);
+        if (k == 0)
+            builds0 = f->nbr_rebuilds;
+        double m2 = 0.0;
+        for (size_t i = 0; i < f->ps.n; i++) {
+            double dx = f->x[i][0] - f->xref[i][0], dy = f->x[i][1] - f->xref[i][1];
+            m2 = fmax(m2, dx * dx + dy * dy);
+        }
+        if (4.0 * m2 > f->skin * f->skin)
+            continue;
+        /* brute force: every pair within re_lap must be in the list */
+        size_t missing = 0;
+        for (size_t i = 0; i < f->ps.n; i++)
+            for (size_t j = 0; j < f->ps.n; j++) {
+                double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
+                if (i == j || dx * dx + dy * dy >= re * re)
+                    continue;
+                int found = 0;
+                for (size_t q = f->nl.start[i]; q < f->nl.start[i + 1] && !found; q++)
+                    found = (size_t)f->nl.j[q] == j;
+                missing += !found;
+            }
+        CHECK(missing == 0);
+        checked++;
+    }
+    printf("Verlet list: %d checks, %ld builds in 119 steps\n", checked,
+           f->nbr_rebuilds - builds0);
+    CHECK(checked > 10);
+    CHECK(f->nbr_rebuilds - builds0 < 119); /* the list is reused */
+    fluid_destroy(&f);
+}
+
+int main(void)
+{
+    test_still_water();
+    test_dambreak_first_step();
+    test_paper_walls();
+    test_verlet_list();
+    return test_summary("test_fluid_step");
+}
