@@ -48,6 +48,7 @@
 
 #include "mps_particles.h"
 #include "mps_timer.h"
+#include "solid_iface.h"
 #include "solid_model.h"
 #include "solid_scene.h"
 
@@ -110,13 +111,8 @@ struct solid_mps {
     size_t probe_i[SOLID_MAX_PROBES][SOLID_MPS_PROBE_MAX];
 
     /* interface cache (solid_model_ops.interface) */
-    double iface_depth;
+    struct solid_iface_cache iface;
     long iface_rev;                  /* surface_rev the cache was built for */
-    size_t iface_n;
-    size_t *iface_idx;
-    int *iface_id;
-    double (*iface_x)[MPS_DIM], (*iface_v)[MPS_DIM];
-    unsigned char *iface_surface, *iface_fixed;
 
     double time;
     long steps;

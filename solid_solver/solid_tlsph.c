@@ -308,7 +308,7 @@ enum mps_status solid_tlsph_create(struct solid_tlsph **out, const struct solid_
     s->hourglass = hourglass;
     s->quadratic = quadratic != 0;
     s->full_count = lattice_count(2.0 * s->h / s->dp);
-    s->iface_depth = -1.0;
+    solid_iface_cache_init(&s->iface);
     size_t n = 0;
     for (int b = 0; b < scene->nbodies; b++) {
         struct solid_tlsph_material *m = &s->mat[b];
@@ -356,12 +356,7 @@ void solid_tlsph_destroy(struct solid_tlsph **sp)
     free(s->pX);
     free(s->pw);
     free(s->pwr);
-    free(s->iface_idx);
-    free(s->iface_id);
-    free(s->iface_x);
-    free(s->iface_v);
-    free(s->iface_surface);
-    free(s->iface_fixed);
+    solid_iface_cache_free(&s->iface);
     free(s);
     *sp = NULL;
 }
@@ -646,84 +641,19 @@ static enum mps_status op_advance(void *self, double dt, struct mps_err *err)
 
 /* Surface particles and those within depth of one, on the reference lattice
  * (the pairs never change, so neither does the topology). */
-static enum mps_status build_iface(struct solid_tlsph *s, double depth, struct mps_err *err)
-{
-    unsigned char *keep = calloc(s->n + 1, 1);
-    if (!keep)
-        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
-    enum mps_status st = MPS_OK;
-    for (size_t i = 0; i < s->n; i++)
-        keep[i] = s->surface[i];
-    if (depth > 0.0) {
-        struct mps_nbr_grid g = {0};
-        struct mps_nbr_list l = {0};
-        double rad = depth * (1.0 + 1e-9);
-        st = mps_nbr_grid_build(&g, s->n, (const double(*)[MPS_DIM])s->x0, rad, err);
-        if (st == MPS_OK)
-            st = mps_nbr_list_build(&l, &g, (const double(*)[MPS_DIM])s->x0, s->n, rad, err);
-        for (size_t i = 0; st == MPS_OK && i < s->n; i++)
-            for (size_t e = l.start[i]; !keep[i] && e < l.start[i + 1]; e++)
-                keep[i] = s->surface[l.j[e]] ? 2 : 0;
-        mps_nbr_list_free(&l);
-        mps_nbr_grid_free(&g);
-    }
-    size_t m = 0;
-    for (size_t i = 0; i < s->n; i++)
-        m += keep[i] != 0;
-    free(s->iface_idx);
-    free(s->iface_id);
-    free(s->iface_x);
-    free(s->iface_v);
-    free(s->iface_surface);
-    free(s->iface_fixed);
-    s->iface_idx = malloc((m + 1) * sizeof *s->iface_idx);
-    s->iface_id = malloc((m + 1) * sizeof *s->iface_id);
-    s->iface_x = malloc((m + 1) * sizeof *s->iface_x);
-    s->iface_v = malloc((m + 1) * sizeof *s->iface_v);
-    s->iface_surface = malloc(m + 1);
-    s->iface_fixed = malloc(m + 1);
-    if (st == MPS_OK && (!s->iface_idx || !s->iface_id || !s->iface_x || !s->iface_v ||
-                         !s->iface_surface || !s->iface_fixed))
-        st = mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
-    if (st == MPS_OK) {
-        m = 0;
-        for (size_t i = 0; i < s->n; i++)
-            if (keep[i]) {
-                s->iface_idx[m] = i;
-                s->iface_id[m] = s->id[i];
-                s->iface_surface[m] = keep[i] == 1;
-                s->iface_fixed[m] = s->fixed[i];
-                m++;
-            }
-        s->iface_n = m;
-        s->iface_depth = depth;
-    } else {
-        s->iface_n = 0;
-        s->iface_depth = -1.0;
-    }
-    free(keep);
-    return st;
-}
-
 static enum mps_status op_interface(void *self, double depth, struct solid_iface *out,
                                     struct mps_err *err)
 {
     struct solid_tlsph *s = self;
-    if (depth != s->iface_depth) {
-        enum mps_status st = build_iface(s, depth, err);
+    if (depth != s->iface.depth) {
+        enum mps_status st = solid_iface_cache_build(
+            &s->iface, s->n, (const double(*)[MPS_DIM])s->x0, s->surface, s->id, s->fixed,
+            depth, err);
         if (st != MPS_OK)
             return st;
     }
-    for (size_t k = 0; k < s->iface_n; k++) {
-        size_t i = s->iface_idx[k];
-        for (int a = 0; a < MPS_DIM; a++) {
-            s->iface_x[k][a] = s->x[i][a];
-            s->iface_v[k][a] = s->v[i][a];
-        }
-    }
-    *out = (struct solid_iface){s->iface_n, s->iface_id, (const double(*)[MPS_DIM])s->iface_x,
-                                (const double(*)[MPS_DIM])s->iface_v, s->iface_surface,
-                                s->iface_fixed};
+    solid_iface_cache_fill(&s->iface, (const double(*)[MPS_DIM])s->x,
+                           (const double(*)[MPS_DIM])s->v, out);
     return MPS_OK;
 }
 

@@ -74,6 +74,7 @@
 
 #include "mps_particles.h"
 #include "mps_timer.h"
+#include "solid_iface.h"
 #include "solid_model.h"
 #include "solid_scene.h"
 
@@ -130,12 +131,7 @@ struct solid_tlsph {
     int probe_n[SOLID_MAX_PROBES];
     size_t probe_i[SOLID_MAX_PROBES][SOLID_TLSPH_PROBE_MAX];
 
-    double iface_depth;
-    size_t iface_n;
-    size_t *iface_idx;
-    int *iface_id;
-    double (*iface_x)[MPS_DIM], (*iface_v)[MPS_DIM];
-    unsigned char *iface_surface, *iface_fixed;
+    struct solid_iface_cache iface; /* solid_model_ops.interface */
 
     double time;
     long steps;

@@ -4,27 +4,16 @@
 
 #include <stdio.h>
 #include <stdlib.h>
-#include <string.h>
 
+#include "solid_test_util.h" /* block_scene, test_rand */
 #include "solid_tlsph.h"
 
-/* One rectangle body, nx by ny particles of spacing dp from the origin, no
- * gravity, no clamp, plane stress, rho = 1000. */
+/* block_scene: one rectangle body, nx by ny particles of spacing dp from the
+ * origin, no gravity, no clamp, plane stress, rho = 1000. */
 static inline void tl_block_scene(struct solid_scene *s, int nx, int ny, double dp, double E,
                                   double nu, double courant)
 {
-    memset(s, 0, sizeof *s);
-    s->dp = dp;
-    s->courant = courant;
-    s->plane = SOLID_PLANE_STRESS;
-    s->nbodies = 1;
-    struct solid_body_def *b = &s->bodies[0];
-    snprintf(b->name, sizeof b->name, "block");
-    b->x1 = nx * dp;
-    b->y1 = ny * dp;
-    b->rho = 1000.0;
-    b->E = E;
-    b->nu = nu;
+    block_scene(s, nx, ny, dp, E, nu, courant);
 }
 
 /* 1: tests run the second-order correction (solid.tlsph.correction) */
@@ -44,8 +33,7 @@ static inline struct solid_tlsph *tl_make(const struct solid_scene *sc, double a
 /* A reproducible number in [-1, 1]. */
 static inline double tl_rand(unsigned long *state)
 {
-    *state = *state * 6364136223846793005UL + 1442695040888963407UL;
-    return (double)(*state >> 11) / (double)(1UL << 53) * 2.0 - 1.0;
+    return test_rand(state);
 }
 
 static inline double tl_energy(const struct solid_tlsph *m)
