@@ -7,7 +7,8 @@ set -eu
 cd "$(dirname "$0")"
 
 PKGS="build-essential cmake pkg-config libzmq3-dev libhdf5-dev libsuitesparse-dev \
-libopenblas-dev libyaml-dev python3 python3-numpy python3-zmq python3-h5py python3-matplotlib"
+libopenblas-dev libyaml-dev python3 python3-numpy python3-zmq python3-h5py python3-matplotlib \
+python3-yaml procps"
 
 missing=""
 for p in $PKGS; do
