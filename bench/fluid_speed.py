@@ -22,7 +22,7 @@ def run(binary, dp, end, threads, extra=()):
     with open(os.path.join(out, 'summary.json')) as f:
         s = json.load(f)
     s['failed'] = rc != 0
-    return s, ' '.join(cmd[1:]).replace(ROOT + '/', '')
+    return s, ' '.join(cmd).replace(ROOT + '/', '')
 
 
 def main():
@@ -42,7 +42,7 @@ def main():
              ' | total ns/particle-step |',
              '|' + '---|' * (len(phases) + 6)]
     for dp in [float(s) for s in args.sizes.split(',')]:
-        end = 0.02 if dp > 0.001 else 0.01
+        end = 0.08 if dp > 0.003 else 0.04 if dp > 0.0015 else 0.01
         for t in threads:
             s, _ = run(args.bin, dp, end, t)
             n = s['particles']['total']
@@ -59,7 +59,7 @@ def main():
         reached = f" (stopped at t = {s['simulated_time']:.3f} s: {s['message']})" if s['failed'] else ''
         lines.append(f"| 3.00 | {s['particles']['fluid']} | {t} | {s['steps']}{reached} | "
                      f"{s['wall_seconds']:.1f} | {s['ns_per_particle_step']:.0f} |")
-    lines += ['', f'Command of the last row: `OMP_NUM_THREADS={threads[-1]} build/bin/{cmd}`', '']
+    lines += ['', f'Command of the last row: `OMP_NUM_THREADS={threads[-1]} {cmd}`', '']
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     with open(args.out, 'w') as f:
         f.write('\n'.join(lines))
