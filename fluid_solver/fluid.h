@@ -75,6 +75,7 @@ struct fluid {
     long ppe_iterations;
     long nbr_rebuilds;
     long lost;             /* fluid particles that splashed out of an open tank */
+    long wall_guard;       /* times a particle was put back inside the tank */
     struct mps_timer timer;
 };
 

@@ -117,6 +117,7 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
     mps_json_num(j, "ppe_iterations_per_step", f->step ? (double)f->ppe_iterations / f->step : 0);
     mps_json_int(j, "neighbour_builds", f->nbr_rebuilds);
     mps_json_int(j, "lost_particles", f->lost);
+    mps_json_int(j, "wall_guard_uses", f->wall_guard);
     mps_json_str(j, "ppe_solver", fluid_linsolve_method(f->ls));
     double total = mps_timer_total(&f->timer);
     mps_json_num(j, "step_seconds", total);
