@@ -134,11 +134,7 @@ static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, 
         int j = nl->j[k];
         if (!USE(in, j))
             continue;
-        double dx[MPS_DIM], r2 = 0.0;
-        for (int d = 0; d < MPS_DIM; d++) {
-            dx[d] = in->x[j][d] - in->x[i][d];
-            r2 += dx[d] * dx[d];
-        }
+        double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])in->x, i, (size_t)j, dx);
         if (r2 >= re2 || r2 <= 0.0)
             continue;
         double r = sqrt(r2), w = mps_weight(r, in->re);

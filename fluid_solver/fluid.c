@@ -321,11 +321,7 @@ static void shift(struct fluid *f, double dt)
         int near_surf = f->surface[i];
         for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
             int j = f->nl_n.j[k];
-            double dx[MPS_DIM], r2 = 0.0;
-            for (int d = 0; d < MPS_DIM; d++) {
-                dx[d] = f->x[j][d] - f->x[i][d];
-                r2 += dx[d] * dx[d];
-            }
+            double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
             if (r2 >= re2 || r2 <= 0.0)
                 continue;
             double r = sqrt(r2), dw = re / r2; /* -w'(r) */
@@ -387,11 +383,7 @@ static void surface_scan(struct fluid *f)
         double m[MPS_DIM] = {0};
         for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
             int j = f->nl_n.j[k];
-            double dx[MPS_DIM], r2 = 0.0;
-            for (int d = 0; d < MPS_DIM; d++) {
-                dx[d] = f->x[j][d] - f->x[i][d];
-                r2 += dx[d] * dx[d];
-            }
+            double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
             if (r2 >= re2 || r2 <= 0.0)
                 continue;
             double w = mps_weight(sqrt(r2), re);

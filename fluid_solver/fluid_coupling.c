@@ -116,11 +116,7 @@ size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
                 int j = f->nl.j[k];
                 if (!f->is_fluid[j] && f->type[j] != SOLID_SURF_P)
                     continue; /* walls do not load the solid */
-                double dx[MPS_DIM], r2 = 0.0;
-                for (int d = 0; d < MPS_DIM; d++) {
-                    dx[d] = f->x[j][d] - f->x[i][d];
-                    r2 += dx[d] * dx[d];
-                }
+                double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
                 if (r2 >= re2 || r2 <= 0.0)
                     continue;
                 double w = mps_weight(sqrt(r2), re), pij = 0.5 * (f->p[i] + f->p[j]);
