@@ -615,6 +615,26 @@ int main(int argc, char **argv)
         return 2;
     }
 
+    /* The solvers' cross-key checks (a block outside the tank, an empty clamp,
+     * ...) run here too, so an error names the user's file or --set, not the
+     * resolved copy, and nothing is launched for a case that cannot run. */
+    {
+        struct fluid_params fp;
+        struct solid_scene *sc = c.p[SOLID].needed ? malloc(sizeof *sc) : NULL;
+        if (c.p[SOLID].needed && !sc)
+            st = mps_err_set(&err, MPS_ENOMEM, "coupler: out of memory");
+        else if (c.p[FLUID].needed)
+            st = fluid_params_read(&fp, c.cs, &err);
+        if (!st && sc)
+            st = solid_scene_read(sc, c.cs, &err);
+        free(sc);
+        if (st) {
+            fprintf(stderr, "coupler: %s\n", err.msg);
+            mps_case_destroy(&c.cs);
+            return mps_status_exit_code(st);
+        }
+    }
+
     char resolved[4200];
     if ((st = mps_mkdir_p(c.out, &err)))
         goto end;

@@ -28,3 +28,7 @@ fluid_expect_fail(coupler_bad_negative_dp "coupler: .*dp = -0.004: must be > 0"
                   ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set dp=-0.004)
 fluid_expect_fail(coupler_bad_no_scene "neither a fluid .* nor a solid"
                   ${CMAKE_BINARY_DIR}/bin/coupler tests/fluid/empty_case.yml ${OUT})
+# a cross-key error is caught by the coupler itself and names the --set, not the
+# resolved copy the solvers read
+fluid_expect_fail(coupler_bad_block_outside "coupler: --set fluid.blocks.0.x1=0.7: fluid.blocks.0.x1 = 0.7: the water block lies outside the tank"
+                  ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set fluid.blocks.0.x1=0.7)
