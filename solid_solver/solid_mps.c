@@ -197,16 +197,7 @@ done:
 static void find_probes(struct solid_mps *s)
 {
     s->nprobes = s->scene.nprobes;
-    for (int k = 0; k < s->nprobes; k++) {
-        const struct solid_probe_def *p = &s->scene.probes[k];
-        double best = INFINITY;
-        for (size_t i = 0; i < s->n; i++)
-            best = fmin(best, hypot(s->x0[i][0] - p->x, s->x0[i][1] - p->y));
-        s->probe_n[k] = 0;
-        for (size_t i = 0; i < s->n && s->probe_n[k] < SOLID_MPS_PROBE_MAX; i++)
-            if (hypot(s->x0[i][0] - p->x, s->x0[i][1] - p->y) <= best + 1e-6 * s->dp)
-                s->probe_i[k][s->probe_n[k]++] = i;
-    }
+    solid_probes_locate(&s->scene, s->n, (const double(*)[MPS_DIM])s->x0, s->probe_n, s->probe_i);
 }
 
 enum mps_status solid_mps_create(struct solid_mps **out, const struct solid_scene *scene,
@@ -435,18 +426,8 @@ void solid_mps_diag(const struct solid_mps *s, struct solid_mps_diag *dg)
 
 double solid_mps_probe(const struct solid_mps *s, int k)
 {
-    const struct solid_probe_def *p = &s->scene.probes[k];
-    double sum = 0.0;
-    for (int a = 0; a < s->probe_n[k]; a++) {
-        size_t i = s->probe_i[k][a];
-        switch (p->kind) {
-        case SOLID_PROBE_DX: sum += s->x[i][0] - s->x0[i][0]; break;
-        case SOLID_PROBE_DY: sum += s->x[i][1] - s->x0[i][1]; break;
-        case SOLID_PROBE_X: sum += s->x[i][0]; break;
-        case SOLID_PROBE_Y: sum += s->x[i][1]; break;
-        }
-    }
-    return s->probe_n[k] ? sum / s->probe_n[k] : NAN;
+    return solid_probe_value(&s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
+                             (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0);
 }
 
 /* ---- solid_model_ops ---- */
@@ -473,17 +454,7 @@ static double op_stable_dt(const void *self)
 static enum mps_status op_set_loads(void *self, const struct solid_loads *f, struct mps_err *err)
 {
     struct solid_mps *s = self;
-    memset(s->aload, 0, s->n * sizeof *s->aload);
-    for (size_t k = 0; f && k < f->n; k++) {
-        int i = f->id[k];
-        if (i < 0 || (size_t)i >= s->n)
-            return mps_err_set(err, MPS_EINPUT, "solid: load on unknown particle id %d "
-                               "(ids are 0..%zu)", i, s->n - 1);
-        double m = s->mat[s->body[i]].rho * s->dp * s->dp; /* V = dp^2 per metre depth */
-        for (int a = 0; a < MPS_DIM; a++)
-            s->aload[i][a] = f->force[k][a] / m;
-    }
-    return MPS_OK;
+    return solid_loads_accel(&s->scene, s->body, s->n, f, s->aload, err);
 }
 
 static enum mps_status op_advance(void *self, double dt, struct mps_err *err)

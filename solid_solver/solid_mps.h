@@ -58,7 +58,7 @@
 
 #define SOLID_MPS_RE 2.1        /* effective radius / dp (paper section 3) */
 #define SOLID_MPS_NC 0.5        /* surface if n0_i < n0_lattice - nc (Eq. 48) */
-#define SOLID_MPS_PROBE_MAX 8   /* particles averaged by one probe (ties) */
+#define SOLID_MPS_PROBE_MAX SOLID_PROBE_TIES /* particles averaged by one probe */
 #define SOLID_MPS_OMP_MIN 4096  /* below this many particles a step runs serial */
 #define SOLID_MPS_NEXTRA 5      /* probes added when fracture or contact is on */
 

@@ -245,3 +245,52 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
     }
     return MPS_OK;
 }
+
+void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x0)[MPS_DIM],
+                         int *probe_n, size_t (*probe_i)[SOLID_PROBE_TIES])
+{
+    for (int k = 0; k < s->nprobes; k++) {
+        const struct solid_probe_def *p = &s->probes[k];
+        double best = INFINITY;
+        for (size_t i = 0; i < n; i++)
+            best = fmin(best, hypot(x0[i][0] - p->x, x0[i][1] - p->y));
+        probe_n[k] = 0;
+        for (size_t i = 0; i < n && probe_n[k] < SOLID_PROBE_TIES; i++)
+            if (hypot(x0[i][0] - p->x, x0[i][1] - p->y) <= best + 1e-6 * s->dp)
+                probe_i[k][probe_n[k]++] = i;
+    }
+}
+
+double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
+                         const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
+                         const double (*x0)[MPS_DIM])
+{
+    double sum = 0.0;
+    for (int a = 0; a < probe_n[k]; a++) {
+        size_t i = probe_i[k][a];
+        switch (s->probes[k].kind) {
+        case SOLID_PROBE_DX: sum += x[i][0] - x0[i][0]; break;
+        case SOLID_PROBE_DY: sum += x[i][1] - x0[i][1]; break;
+        case SOLID_PROBE_X: sum += x[i][0]; break;
+        case SOLID_PROBE_Y: sum += x[i][1]; break;
+        }
+    }
+    return probe_n[k] ? sum / probe_n[k] : NAN;
+}
+
+enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, size_t n,
+                                  const struct solid_loads *f, double (*aload)[MPS_DIM],
+                                  struct mps_err *err)
+{
+    memset(aload, 0, n * sizeof *aload);
+    for (size_t k = 0; f && k < f->n; k++) {
+        int i = f->id[k];
+        if (i < 0 || (size_t)i >= n)
+            return mps_err_set(err, MPS_EINPUT, "solid: load on unknown particle id %d "
+                               "(ids are 0..%zu)", i, n - 1);
+        double m = s->bodies[body[i]].rho * s->dp * s->dp; /* V = dp^2 per metre depth */
+        for (int a = 0; a < MPS_DIM; a++)
+            aload[i][a] = f->force[k][a] / m;
+    }
+    return MPS_OK;
+}

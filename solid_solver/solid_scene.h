@@ -8,6 +8,7 @@
 #include "mps_case.h"
 #include "mps_dim.h"
 #include "mps_err.h"
+#include "solid_model.h"
 
 #define SOLID_MAX_BODIES 32
 #define SOLID_MAX_CLAMPS 32
@@ -74,6 +75,27 @@ extern const struct mps_key_spec solid_case_keys[];
  * clamp naming an unknown body are errors naming the key). */
 enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c,
                                  struct mps_err *err);
+
+/* Particles one probe averages at most (a tip probe between two rows takes
+ * the mean of both). */
+#define SOLID_PROBE_TIES 8
+
+/* For each probe of the scene, the particles nearest its point on the initial
+ * lattice x0 (ties within 1e-6 dp all kept, up to SOLID_PROBE_TIES). */
+void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x0)[MPS_DIM],
+                         int *probe_n, size_t (*probe_i)[SOLID_PROBE_TIES]);
+
+/* Probe k's current value: the mean over its particles of dx, dy, x or y. */
+double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
+                         const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
+                         const double (*x0)[MPS_DIM]);
+
+/* Fluid loads (force per particle, N per metre depth) as accelerations:
+ * aload[i] = force / (rho_body V), V = dp^2; particles not listed get zero.
+ * An id outside 0..n-1 is MPS_EINPUT. */
+enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, size_t n,
+                                  const struct solid_loads *f, double (*aload)[MPS_DIM],
+                                  struct mps_err *err);
 
 /* Lattice columns and rows of body b (0 if it holds no particle). */
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny);

@@ -85,7 +85,7 @@
 #define SOLID_TLSPH_HDP 1.3         /* h / dp: support 2.6 dp, 20 neighbours */
 #define SOLID_TLSPH_VISC_CFL 0.6    /* viscous term of the stable step, see below */
 #define SOLID_TLSPH_QUAD_DT 0.55    /* step factor of the quadratic correction (measured) */
-#define SOLID_TLSPH_PROBE_MAX 8
+#define SOLID_TLSPH_PROBE_MAX SOLID_PROBE_TIES /* particles averaged by one probe */
 
 struct solid_tlsph_material {
     double rho, E, nu, lambda, mu;  /* kg/m^3, Pa, -, Pa, Pa */
