@@ -243,6 +243,15 @@ enum mps_status solid_mps_create(struct solid_mps **out, const struct solid_scen
         return st;
     }
     find_probes(s);
+    if (scene->mps_damping > 0.0 && s->spin_omega > 0.0) {
+        s->damp_tau = 2.0 * scene->mps_damping / s->spin_omega;
+        s->vold = malloc(s->n * sizeof *s->vold);
+        s->wold = malloc(s->n * sizeof *s->wold);
+        if (!s->vold || !s->wold) {
+            solid_mps_destroy(&s);
+            return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+        }
+    }
     int contact = s->frac && scene->contact != SOLID_CONTACT_NONE;
     mps_timer_init(&s->timer, phase_names, contact ? SOLID_PH_N : SOLID_PH_CONTACT);
     *out = s;
@@ -263,6 +272,8 @@ void solid_mps_destroy(struct solid_mps **sp)
     free(s->bk);
     free(s->bb);
     free(s->bbr);
+    free(s->vold);
+    free(s->wold);
     solid_iface_cache_free(&s->iface);
     free(s);
     *sp = NULL;
@@ -274,7 +285,9 @@ double solid_mps_stable_dt(const struct solid_mps *s)
     for (int b = 0; b < s->scene.nbodies; b++)
         c = fmax(c, s->mat[b].wave_speed);
     double dt_wave = c > 0.0 ? s->dp / c : INFINITY;
-    double dt_spin = s->spin_omega > 0.0 ? 2.0 / s->spin_omega : INFINITY;
+    double z = s->scene.mps_damping;
+    double dt_spin = s->spin_omega > 0.0 ? 2.0 * (sqrt(1.0 + z * z) - z) / s->spin_omega
+                                         : INFINITY;
     return s->courant * fmin(dt_wave, dt_spin);
 }
 
@@ -336,6 +349,15 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
         strain_pass(s);
 
     mps_timer_switch(&s->timer, SOLID_PH_FORCE);
+    /* the damping reads the velocities of the step's start (v and omega are
+     * updated in place below) */
+    const double tau = s->damp_tau;
+    const double(*vo)[MPS_DIM] = (const double(*)[MPS_DIM])s->vold;
+    const double *wo = s->wold;
+    if (tau > 0.0) {
+        memcpy(s->vold, v, n * sizeof *v);
+        memcpy(s->wold, omega, n * sizeof *omega);
+    }
 #pragma omp parallel for schedule(static) if (n >= SOLID_MPS_OMP_MIN)
     for (size_t i = 0; i < n; i++) {
         if (fixed[i])
@@ -344,6 +366,12 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
         double ax = 0.0, ay = 0.0, tq = 0.0;
         for (size_t b = bstart[i]; b < bstart[i + 1]; b++) {
             BOND_U(i, b);
+            if (tau > 0.0) { /* Kelvin-Voigt: u + tau du/dt (header) */
+                double wm = 0.5 * (wo[i] + wo[j]);
+                double ax0 = rx - ux, ay0 = ry - uy; /* R r0 */
+                ux += tau * (vo[j][0] - vo[i][0] + wm * ay0);
+                uy += tau * (vo[j][1] - vo[i][1] - wm * ax0);
+            }
             /* Eq. 36-37 (normal + shear stress) and Eq. 38 as -grad p; one add
              * per bond into each sum keeps the dependency chains short. */
             double k = bk[b], f = (qi * bb[b] + q[j] * bbr[b]) / r;

@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 
 #define ANY (MPS_KEY_NO_LO | MPS_KEY_NO_HI)
@@ -18,6 +19,9 @@ const struct mps_key_spec solid_case_keys[] = {
      "TLSPH hourglass stiffness, fraction of E (solid_tlsph.h)"},
     {"solid.tlsph.correction", MPS_KEY_ENUM, "linear", 0, 0, 0, "linear|quadratic", "",
      "TLSPH kernel gradient correction: exact for linear or quadratic fields"},
+    {"solid.mps.damping", MPS_KEY_DOUBLE, "0", 0, 0.5, 0, NULL, "",
+     "MPS solid: damping ratio of the spin (highest) frequency, Kelvin-Voigt on the bonds; "
+     "0 = the paper (solid_mps.h)"},
     {"solid.courant", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "fraction of the stable explicit step, in (0, 1]"},
     {"solid.plane", MPS_KEY_ENUM, "strain", 0, 0, 0, "strain|stress", "",
@@ -132,6 +136,7 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
     s->g[0] = mps_case_double(c, "gravity.x");
     s->g[1] = mps_case_double(c, "gravity.y");
     s->courant = mps_case_double(c, "solid.courant");
+    s->mps_damping = mps_case_double(c, "solid.mps.damping");
     s->plane = strcmp(mps_case_string(c, "solid.plane"), "strain") == 0 ? SOLID_PLANE_STRAIN
                                                                           : SOLID_PLANE_STRESS;
     s->eps_max = mps_case_has(c, "solid.eps_max") ? mps_case_double(c, "solid.eps_max") : 0.0;
@@ -283,14 +288,29 @@ enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, 
                                   struct mps_err *err)
 {
     memset(aload, 0, n * sizeof *aload);
-    for (size_t k = 0; f && k < f->n; k++) {
+    if (!f || f->n == 0)
+        return MPS_OK;
+    /* PROTOCOL.md 5: ids are unique within a message; a receiver rejects a
+     * duplicate rather than keep one of the two loads */
+    unsigned char *seen = calloc(n ? n : 1, 1);
+    if (!seen)
+        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory (%zu load marks)", n);
+    enum mps_status st = MPS_OK;
+    for (size_t k = 0; k < f->n; k++) {
         int i = f->id[k];
-        if (i < 0 || (size_t)i >= n)
-            return mps_err_set(err, MPS_EINPUT, "solid: load on unknown particle id %d "
-                               "(ids are 0..%zu)", i, n - 1);
+        if (i < 0 || (size_t)i >= n) {
+            st = mps_err_set(err, MPS_EINPUT, "solid: load on unknown particle id %d "
+                             "(ids are 0..%zu)", i, n - 1);
+            break;
+        }
+        if (seen[i]++) {
+            st = mps_err_set(err, MPS_EINPUT, "solid: two loads on particle id %d", i);
+            break;
+        }
         double m = s->bodies[body[i]].rho * s->dp * s->dp; /* V = dp^2 per metre depth */
         for (int a = 0; a < MPS_DIM; a++)
             aload[i][a] = f->force[k][a] / m;
     }
-    return MPS_OK;
+    free(seen);
+    return st;
 }

@@ -59,6 +59,7 @@ struct solid_scene {
     double dp;               /* lattice spacing, m */
     double g[MPS_DIM];       /* body force per unit mass, m/s^2 */
     double courant;          /* (0, 1]: fraction of the stable step, see solid_mps.h */
+    double mps_damping;      /* MPS solid: damping ratio at the spin frequency (solid_mps.h) */
     enum solid_plane plane;
     double eps_max;          /* bond breaking strain (Eq. 47); 0: no fracture */
     enum solid_contact contact;
@@ -92,7 +93,7 @@ double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
 
 /* Fluid loads (force per particle, N per metre depth) as accelerations:
  * aload[i] = force / (rho_body V), V = dp^2; particles not listed get zero.
- * An id outside 0..n-1 is MPS_EINPUT. */
+ * An id outside 0..n-1, or listed twice, is MPS_EINPUT. */
 enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, size_t n,
                                   const struct solid_loads *f, double (*aload)[MPS_DIM],
                                   struct mps_err *err);
