@@ -107,6 +107,22 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         }
         if (proto_text_get(in.text, '\n', "timeout_ms", tms, sizeof tms) == 1)
             timeout_ms = atol(tms);
+        /* PROTOCOL.md 4: a key this solver does not know is an input error, not
+         * something to skip (a newer coupler may rely on it) */
+        for (const char *line = in.text; line && *line;) {
+            const char *end = strchr(line, '\n'), *eq = strchr(line, '=');
+            size_t len = end ? (size_t)(end - line) : strlen(line);
+            size_t klen = eq && (size_t)(eq - line) < len ? (size_t)(eq - line) : len;
+            static const char *const known[] = {"case", "out", "prefix", "timeout_ms"};
+            int ok = len == 0;
+            for (int k = 0; k < 4 && !ok; k++)
+                ok = strlen(known[k]) == klen && strncmp(line, known[k], klen) == 0;
+            if (!ok) {
+                st = mps_err_set(err, MPS_EINPUT, "CONFIG key '%.*s' unknown", (int)klen, line);
+                goto fail;
+            }
+            line = end ? end + 1 : NULL;
+        }
         double t0 = mps_wall_seconds();
         st = ops->configure(self, case_path, out, prefix, err);
         configured = 1;

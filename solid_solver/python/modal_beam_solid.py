@@ -12,6 +12,10 @@ mode normalised to phi(L) = 1. Then M q'' + K q = F with M = rho b int phi^2,
 K = E b^3/12 int phi''^2 (= omega_1^2 M) and F = sum_k f_x,k phi(s_k), the
 generalised force of the fluid loads. q is the tip deflection (probe tip_dx).
 
+Snapshots (at startup and after an ADVANCE with SNAPSHOT) are CSV files
+OUT/PREFIX_NNNNNN.csv. Failures are reported to the coupler as ERROR
+(PROTOCOL.md 8). tests/coupler/conformance.py checks it against the protocol.
+
 usage: modal_beam_solid.py [--courant C] --connect ENDPOINT
 """
 import json, math, os, sys, time
@@ -82,25 +86,52 @@ class Beam:
             self.q += h * self.qd
 
 
-def main():
-    args = sys.argv[1:]
-    endpoint = args[args.index('--connect') + 1]
-    courant = float(args[args.index('--courant') + 1]) if '--courant' in args else 0.5
-    t_wall = time.time()
+class Fail(Exception):
+    """A failure to report as ERROR "STATUS: message" (PROTOCOL.md section 8)."""
+
+    def __init__(self, status, message):
+        super().__init__(f'{status}: {message}')
+
+
+CONFIG_KEYS = ('case', 'out', 'prefix', 'timeout_ms')
+
+
+def snapshot(conf, step, t, beam):
+    """Writes OUT/PREFIX_NNNNNN.csv (id, x, y, vx, vy, surface, fixed): the
+    protocol asks for a snapshot at startup and after an ADVANCE with SNAPSHOT;
+    the format is the solver's own."""
+    x, v = beam.state()
+    path = os.path.join(conf['out'], f"{conf['prefix']}_{step:06d}.csv")
+    try:
+        np.savetxt(path, np.column_stack([beam.id, x, v, beam.surface, beam.fixed]),
+                   fmt=['%d', '%.17g', '%.17g', '%.17g', '%.17g', '%d', '%d'], delimiter=',',
+                   header=f'time = {t!r} s\nid,x,y,vx,vy,surface,fixed')
+    except OSError as e:
+        raise Fail('io', f'cannot write {path}: {e}') from e
+
+
+def converse(sock, courant, t_wall):
+    """The solver's side of the conversation after HELLO; returns the exit status."""
     compute = 0.0
-    ctx = zmq.Context()
-    sock = mp.connect(ctx, endpoint)
-    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
     cfg = mp.recv(sock, 60000)
     if cfg.type == mp.Type.REJECT:
         print(f'modal_beam_solid: refused: {cfg.text}', file=sys.stderr)
-        return 1
+        return 1  # no reply to a REJECT
+    if cfg.type != mp.Type.CONFIG:
+        raise Fail('protocol', f'expected CONFIG or REJECT after HELLO, got {mp.Type(cfg.type).name}')
     conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
-    with open(conf['case']) as f:
-        case = yaml.safe_load(f)
-    beam = Beam(case, courant)
+    for k in conf:
+        if k not in CONFIG_KEYS:
+            raise Fail('input', f"CONFIG key '{k}' unknown")
+    try:
+        with open(conf['case']) as f:
+            case = yaml.safe_load(f)
+        beam = Beam(case, courant)
+    except (OSError, KeyError, TypeError, ValueError, IndexError, yaml.YAMLError) as e:
+        raise Fail('input', f"case {conf['case']}: {type(e).__name__}: {e}") from e
     timeout = int(conf.get('timeout_ms', '1800000'))
     step = 0
+    snapshot(conf, 0, 0.0, beam)
 
     def state_msg(mtype, **kw):
         x, v = beam.state()
@@ -116,28 +147,56 @@ def main():
                        'omega_1': beam.omega, 'f_1_hz': beam.omega / (2 * math.pi),
                        'coupling_steps': step}
             mp.send(sock, mp.Message(mp.Type.BYE, step=m.step, time=m.time, text=json.dumps(summary)))
-            break
+            return 0
         if m.type == mp.Type.ABORT:
-            return 1
+            print(f'modal_beam_solid: aborted by the coupler: {m.text}', file=sys.stderr)
+            return 1  # no reply to ABORT
         if m.type != mp.Type.ADVANCE:
-            mp.send(sock, mp.Message(mp.Type.ERROR, text=f'protocol: unexpected {m.type}'))
-            return 1
+            raise Fail('protocol', f'expected ADVANCE, STOP or ABORT, got {mp.Type(m.type).name}')
         c0 = time.time()
         beam.force = 0.0
         if m.payload == mp.Payload.LOADS and m.count:
             idx = m.id.astype(np.int64)
+            if idx.max() >= beam.n:
+                raise Fail('input', f'LOADS id {int(idx.max())}: unknown (ids 0..{beam.n - 1})')
+            if len(np.unique(idx)) != len(idx):
+                raise Fail('input', 'LOADS lists an id twice')
             beam.force = float(np.sum(m.force[:, 0] * beam.phi[idx]))
         beam.advance(m.dt / m.n_sub, m.n_sub)
         step += 1
+        if m.flags & mp.F_SNAPSHOT:
+            snapshot(conf, m.step + 1, m.time + m.dt, beam)
         kw = {}
         if m.flags & mp.F_PROBES:
             kw = dict(flags=mp.F_PROBES, probes=np.array([beam.q]))
         res = state_msg(mp.Type.RESULT, step=m.step, iteration=m.iteration, time=m.time + m.dt, **kw)
         compute += time.time() - c0
         mp.send(sock, res)
-    sock.close()
+
+
+def main():
+    args = sys.argv[1:]
+    endpoint = args[args.index('--connect') + 1]
+    courant = float(args[args.index('--courant') + 1]) if '--courant' in args else 0.5
+    ctx = zmq.Context()
+    sock = mp.connect(ctx, endpoint)
+    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
+    try:
+        code = converse(sock, courant, time.time())
+    except (Fail, mp.ProtocolError, TimeoutError) as e:
+        # PROTOCOL.md 7-8: tell the coupler why (best effort), exit 2 for input, else 1
+        text = str(e) if isinstance(e, Fail) else \
+            f"{'protocol' if isinstance(e, mp.ProtocolError) else 'timeout'}: {e}"
+        status = text.split(':', 1)[0]
+        print(f'modal_beam_solid: {text}', file=sys.stderr)
+        try:
+            mp.send(sock, mp.Message(mp.Type.ERROR, text=text))
+        except (zmq.ZMQError, mp.ProtocolError):
+            pass
+        code = 2 if status == 'input' else 1
+    sock.close()  # linger 1 s: a last BYE or ERROR still goes out
     ctx.term()
-    return 0
+    return code
 
 
 if __name__ == '__main__':

@@ -1,0 +1,33 @@
+# Protocol conformance of every solid (tests/coupler/conformance.py plays the
+# coupler's side of proto/PROTOCOL.md and checks the solid's answers).
+set(CONFORMANCE /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/conformance.py)
+set(CONFORMANCE_TOY "/usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/conformance_toy_solid.py")
+
+foreach(model mps tlsph)
+  add_test(NAME conformance_solid_${model}
+           COMMAND ${CONFORMANCE} --solid "${CMAKE_BINARY_DIR}/bin/solid_solver --model ${model}"
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+endforeach()
+add_test(NAME conformance_solid_python
+         COMMAND ${CONFORMANCE}
+                 --solid "/usr/bin/python3 ${CMAKE_SOURCE_DIR}/solid_solver/python/modal_beam_solid.py"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+
+# The suite itself: a toy solid that follows the protocol passes, and each of
+# its deliberate bugs is caught by the check named in the pattern.
+add_test(NAME conformance_toy_solid
+         COMMAND ${CONFORMANCE} --solid "${CONFORMANCE_TOY}"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+foreach(case "step;result\\.echo" "abort;abort\\.exit" "silent;malformed\\.bad_magic\\.error")
+  list(GET case 0 bug)
+  list(GET case 1 pattern)
+  add_test(NAME conformance_catches_bug_${bug}
+           COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh "checks failed .*${pattern}"
+                   ${CONFORMANCE} --solid "${CONFORMANCE_TOY} --bug ${bug}"
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+endforeach()
+
+set_tests_properties(conformance_solid_mps conformance_solid_tlsph conformance_solid_python
+                     conformance_toy_solid conformance_catches_bug_step
+                     conformance_catches_bug_abort conformance_catches_bug_silent
+                     PROPERTIES TIMEOUT 60 LABELS integration ENVIRONMENT OMP_NUM_THREADS=1)
