@@ -63,6 +63,10 @@ struct coupler {
     /* the solid's interface, held between steps (owned decoded message) */
     struct proto_msg state;
     struct proto_msg loads;
+    /* fluid force on the solid integrated since the last probe row (N s/m),
+     * written as its mean over the interval: the load noise of single steps
+     * averages out (columns solid_fx, solid_fy) */
+    double impulse[MPS_DIM], impulse_time;
     struct mps_probes *probes;
     double time;
     long step;
@@ -292,23 +296,34 @@ static enum mps_status exchange(struct coupler *c, int k, struct proto_msg *adv,
 
 static enum mps_status write_probe_row(struct coupler *c, struct mps_err *err)
 {
-    double v[2 * MAX_PROBES];
+    double v[2 * MAX_PROBES + MPS_DIM];
     int n = 0;
     for (int k = 0; k < NPEERS; k++)
         if (c->p[k].needed)
             for (int q = 0; q < c->p[k].nprobes; q++)
                 v[n++] = c->p[k].probes[q];
+    if (c->p[FLUID].needed && c->p[SOLID].needed) {
+        for (int a = 0; a < MPS_DIM; a++) {
+            v[n++] = c->impulse_time > 0.0 ? c->impulse[a] / c->impulse_time : 0.0;
+            c->impulse[a] = 0.0;
+        }
+        c->impulse_time = 0.0;
+    }
     return mps_probes_write(c->probes, c->time, v, err);
 }
 
 static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
 {
-    const char *names[2 * MAX_PROBES];
+    const char *names[2 * MAX_PROBES + MPS_DIM];
     int n = 0;
     for (int k = 0; k < NPEERS; k++)
         if (c->p[k].needed)
             for (int q = 0; q < c->p[k].nprobes; q++)
                 names[n++] = c->p[k].probe_names[q];
+    if (c->p[FLUID].needed && c->p[SOLID].needed) {
+        names[n++] = "solid_fx";
+        names[n++] = "solid_fy";
+    }
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", c->out);
     return mps_probes_open(&c->probes, path, names, n, err);
@@ -374,6 +389,10 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
             proto_msg_clear(&c->loads);
             c->loads = res; /* the solid's load for this interval */
             res = (struct proto_msg){0};
+            for (size_t q = 0; q < c->loads.count; q++)
+                for (int a = 0; a < MPS_DIM; a++)
+                    c->impulse[a] += dt * c->loads.force[q][a];
+            c->impulse_time += dt;
         }
         if (c->p[SOLID].needed) {
             struct proto_msg sadv = adv;
