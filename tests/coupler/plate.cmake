@@ -4,9 +4,12 @@
 # methods). Band for this resolution: a 2-row plate has 0.75 of the bending
 # stiffness of b^3/12 (more deflection) and the coarse water front is blunter
 # (less impulse), so the check allows about 25% either side of the published
-# band, 0.031-0.061 m, and 0.18-0.32 s for the time of the peak.
+# band, 0.031-0.061 m, and 0.18-0.32 s for the time of the peak. The run goes
+# on to 1.5 s, through the phase where water surrounds the plate: the plate
+# must stay within 5 cm after 0.5 s (the references stay within 2-3 cm; with
+# the MPS solid undamped the spin mode tore the plate at 1.05 s, 21 cm).
 add_test(NAME coupled_dambreak_plate_coarse
-         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6 --quiet --set dp=0.006 --set end_time=0.4 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 0.4 --peak-band 0.031 0.061 --peak-time 0.18 0.32"
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6 --quiet --set dp=0.006 --set end_time=1.5 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 1.0 --peak-band 0.031 0.061 --peak-time 0.18 0.32 --max-after 0.5 0.05"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupled_dambreak_plate_coarse PROPERTIES TIMEOUT 300 LABELS validation)
 
