@@ -15,8 +15,10 @@ static const char *const phase_names[PH_COUNT] = {
 
 /* Skin added to the Laplacian radius so one neighbour list serves several
  * steps (a Verlet list): it is rebuilt once some particle has moved more
- * than half the skin since the list was built. */
-#define SKIN_FRACTION 0.5
+ * than half the skin since the list was built. 1 dp: at 4 mm the dam break
+ * rebuilds every 3 steps instead of 1.5 and runs 8% faster than with 0.5 dp
+ * (2 runs each; the longer list costs more in the PPE assembly). */
+#define SKIN_FRACTION 1.0
 /* Fluid particles are sorted by cell every this many list builds. */
 #define REORDER_EVERY 10
 
