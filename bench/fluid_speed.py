@@ -60,6 +60,13 @@ def main():
         lines.append(f"| 3.00 | {s['particles']['fluid']} | {t} | {s['steps']}{reached} | "
                      f"{s['wall_seconds']:.1f} | {s['ns_per_particle_step']:.0f} |")
     lines += ['', f'Command of the last row: `OMP_NUM_THREADS={threads[-1]} {cmd}`', '']
+    # the hand-written reading of the figures (from "## Reading it" on) is kept
+    if os.path.exists(args.out):
+        with open(args.out) as f:
+            old = f.read()
+        k = old.find('## Reading it')
+        if k >= 0:
+            lines += [old[k:].rstrip('\n'), '']
     os.makedirs(os.path.dirname(args.out), exist_ok=True)
     with open(args.out, 'w') as f:
         f.write('\n'.join(lines))
