@@ -17,7 +17,7 @@ set_tests_properties(coupled_dambreak_plate_coarse PROPERTIES TIMEOUT 300 LABELS
 # the gate must open downstream (the free end moves right and up).
 foreach(model mps tlsph)
   add_test(NAME coupled_elastic_gate_${model}
-           COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/elastic_gate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/gate_${model} --quiet --set dp=0.0025 --set end_time=0.12 --solid 'solid_solver --model ${model}' && /usr/bin/python3 tests/coupler/gate_check.py ${CMAKE_BINARY_DIR}/test_out/gate_${model}"
+           COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/elastic_gate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/gate_${model} --quiet --set dp=0.0025 --set end_time=0.2 --solid 'solid_solver --model ${model}' && /usr/bin/python3 tests/coupler/gate_check.py ${CMAKE_BINARY_DIR}/test_out/gate_${model}"
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   set_tests_properties(coupled_elastic_gate_${model} PROPERTIES TIMEOUT 300 LABELS validation)
 endforeach()
