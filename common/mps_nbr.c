@@ -1,6 +1,7 @@
 #include "mps_nbr.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -86,6 +87,10 @@ enum mps_status mps_nbr_grid_build(struct mps_nbr_grid *g, size_t n, const doubl
     for (size_t c = ncells; c > 0; c--)
         g->cell_start[c] = g->cell_start[c - 1];
     g->cell_start[0] = 0;
+    if (grow((void **)&g->xs, &g->cap_xs, n + 1, sizeof *g->xs))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour grid: out of memory");
+    for (size_t k = 0; k < n; k++)
+        memcpy(g->xs[k], x[g->sorted[k]], sizeof g->xs[k]);
     return MPS_OK;
 }
 
@@ -94,13 +99,13 @@ void mps_nbr_grid_free(struct mps_nbr_grid *g)
     free(g->cell_start);
     free(g->sorted);
     free(g->cell_of);
+    free(g->xs);
     memset(g, 0, sizeof *g);
 }
 
 
-/* Visits the neighbours of i; count-only when out is NULL. Returns count. */
-static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], size_t i,
-                    double r2max, int *jout, double *r2out)
+/* Upper bound on the candidates of i: the particles of its 3^d cells. */
+static size_t candidates(const struct mps_nbr_grid *g, size_t i)
 {
     size_t c = g->cell_of[i];
     int ci[MPS_DIM];
@@ -110,28 +115,13 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
     }
     size_t m = 0;
 #if MPS_DIM == 2
+    int a0 = ci[0] > 0 ? ci[0] - 1 : 0;
+    int a1 = ci[0] + 1 < g->dims[0] ? ci[0] + 1 : g->dims[0] - 1;
     for (int b = ci[1] - 1; b <= ci[1] + 1; b++) {
         if (b < 0 || b >= g->dims[1])
             continue;
-        int a0 = ci[0] > 0 ? ci[0] - 1 : 0;
-        int a1 = ci[0] + 1 < g->dims[0] ? ci[0] + 1 : g->dims[0] - 1;
         size_t row = (size_t)b * (size_t)g->dims[0];
-        /* cells a0..a1 of this row are contiguous in sorted[] */
-        for (size_t k = g->cell_start[row + (size_t)a0]; k < g->cell_start[row + (size_t)a1 + 1];
-             k++) {
-            size_t j = g->sorted[k];
-            if (j == i)
-                continue;
-            double dx = x[j][0] - x[i][0], dy = x[j][1] - x[i][1];
-            double r2 = dx * dx + dy * dy;
-            if (r2 < r2max) {
-                if (jout) {
-                    jout[m] = (int)j;
-                    r2out[m] = r2;
-                }
-                m++;
-            }
-        }
+        m += g->cell_start[row + (size_t)a1 + 1] - g->cell_start[row + (size_t)a0];
     }
 #else
 #error "mps_nbr: only MPS_DIM == 2 is implemented"
@@ -139,50 +129,167 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
     return m;
 }
 
+/* Writes the neighbours of i into jout/r2out (room for candidates(g, i))
+ * sorted by j and returns their number. Each row of cells is a contiguous
+ * stretch of sorted[], in index order within a cell; tmp (same room) holds
+ * the runs before they are merged. */
+static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], size_t i,
+                    double r2max, int *jout, double *r2out, int *jtmp, double *r2tmp)
+{
+    size_t c = g->cell_of[i];
+    int ci[MPS_DIM];
+    for (int d = 0; d < MPS_DIM; d++) {
+        ci[d] = (int)(c % (size_t)g->dims[d]);
+        c /= (size_t)g->dims[d];
+    }
+    const double xi = x[i][0], yi = x[i][1];
+    size_t runs[3 * 3 + 1], nruns = 0, m = 0;
+    runs[0] = 0;
+#if MPS_DIM == 2
+    int a0 = ci[0] > 0 ? ci[0] - 1 : 0;
+    int a1 = ci[0] + 1 < g->dims[0] ? ci[0] + 1 : g->dims[0] - 1;
+    for (int b = ci[1] - 1; b <= ci[1] + 1; b++) {
+        if (b < 0 || b >= g->dims[1])
+            continue;
+        size_t row = (size_t)b * (size_t)g->dims[0];
+        for (int a = a0; a <= a1; a++) {
+            /* one run per cell: sorted by index within the cell */
+            for (size_t k = g->cell_start[row + (size_t)a]; k < g->cell_start[row + (size_t)a + 1];
+                 k++) {
+                double dx = g->xs[k][0] - xi, dy = g->xs[k][1] - yi;
+                double r2 = dx * dx + dy * dy;
+                size_t j = g->sorted[k];
+                if (r2 < r2max && j != i) {
+                    jtmp[m] = (int)j;
+                    r2tmp[m++] = r2;
+                }
+            }
+            if (m > runs[nruns])
+                runs[++nruns] = m;
+        }
+    }
+#endif
+    /* merge the runs pairwise until one is left, ping-ponging between the
+     * two buffers (at most 9 runs: 4 rounds) */
+    int *js = jtmp, *jd = jout;
+    double *rs = r2tmp, *rd = r2out;
+    while (nruns > 1) {
+        size_t w = 0, nr = 0;
+        for (size_t q = 0; q < nruns; q += 2) {
+            size_t p1 = runs[q], e1 = runs[q + 1];
+            size_t p2 = q + 1 < nruns ? runs[q + 1] : e1, e2 = q + 1 < nruns ? runs[q + 2] : e1;
+            while (p1 < e1 && p2 < e2) {
+                if (js[p1] < js[p2]) {
+                    jd[w] = js[p1];
+                    rd[w++] = rs[p1++];
+                } else {
+                    jd[w] = js[p2];
+                    rd[w++] = rs[p2++];
+                }
+            }
+            for (; p1 < e1; p1++, w++) {
+                jd[w] = js[p1];
+                rd[w] = rs[p1];
+            }
+            for (; p2 < e2; p2++, w++) {
+                jd[w] = js[p2];
+                rd[w] = rs[p2];
+            }
+            runs[++nr] = w;
+        }
+        nruns = nr;
+        int *tj = js;
+        js = jd;
+        jd = tj;
+        double *tr = rs;
+        rs = rd;
+        rd = tr;
+    }
+    if (js != jout) {
+        memcpy(jout, js, m * sizeof *jout);
+        memcpy(r2out, rs, m * sizeof *r2out);
+    }
+    return m;
+}
+
 enum mps_status mps_nbr_list_build(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
                                    const double (*x)[MPS_DIM], size_t nquery, double radius,
                                    struct mps_err *err)
+{
+    return mps_nbr_list_build_masked(l, g, x, nquery, NULL, radius, err);
+}
+
+/* One pass: each thread visits a contiguous block of queries into its own
+ * buffer, then copies it to its place once the row offsets are known. */
+enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
+                                          const double (*x)[MPS_DIM], size_t nquery,
+                                          const unsigned char *query, double radius,
+                                          struct mps_err *err)
 {
     if (radius > g->cell * (1.0 + 1e-12))
         return mps_err_set(err, MPS_EINPUT, "neighbour radius %g exceeds cell width %g", radius,
                            g->cell);
     if (grow((void **)&l->start, &l->cap_n, nquery + 1, sizeof(size_t)))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
-    double r2max = radius * radius;
+    const double r2max = radius * radius;
     l->n = nquery;
     l->radius = radius;
     l->start[0] = 0;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < nquery; i++)
-        l->start[i + 1] = visit(g, x, i, r2max, NULL, NULL);
-    for (size_t i = 0; i < nquery; i++)
-        l->start[i + 1] += l->start[i];
-    size_t npairs = l->start[nquery];
-    size_t cap = l->cap_pairs;
-    if (grow((void **)&l->j, &cap, npairs + 1, sizeof(int)))
-        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
-    size_t cap2 = l->cap_pairs;
-    if (grow((void **)&l->r2, &cap2, npairs + 1, sizeof(double)))
-        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
-    l->cap_pairs = cap < cap2 ? cap : cap2;
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < nquery; i++) {
-        size_t s = l->start[i];
-        size_t m = visit(g, x, i, r2max, l->j + s, l->r2 + s);
-        /* sort by j, carrying r2 along (lists are short: insertion sort) */
-        for (size_t a = 1; a < m; a++) {
-            int jj = l->j[s + a];
-            double rr = l->r2[s + a];
-            size_t b = a;
-            while (b > 0 && l->j[s + b - 1] > jj) {
-                l->j[s + b] = l->j[s + b - 1];
-                l->r2[s + b] = l->r2[s + b - 1];
-                b--;
+    int fail = 0;
+    size_t npairs = 0;
+#pragma omp parallel
+    {
+        int nt = omp_get_num_threads(), t = omp_get_thread_num();
+        size_t lo = nquery * (size_t)t / (size_t)nt, hi = nquery * (size_t)(t + 1) / (size_t)nt;
+        int *jb = NULL, *jt = NULL;
+        double *rb = NULL, *rt = NULL;
+        size_t cap = 0, capt = 0, capt2 = 0, cap2 = 0, used = 0;
+        int lfail = 0;
+        for (size_t i = lo; i < hi; i++) {
+            size_t m = 0;
+            if (!query || query[i]) {
+                size_t room = candidates(g, i);
+                if (grow((void **)&jb, &cap, used + room + 1, sizeof *jb) ||
+                    grow((void **)&rb, &cap2, used + room + 1, sizeof *rb) ||
+                    grow((void **)&jt, &capt, room + 1, sizeof *jt) ||
+                    grow((void **)&rt, &capt2, room + 1, sizeof *rt)) {
+                    lfail = 1;
+                    break;
+                }
+                m = visit(g, x, i, r2max, jb + used, rb + used, jt, rt);
             }
-            l->j[s + b] = jj;
-            l->r2[s + b] = rr;
+            l->start[i + 1] = m;
+            used += m;
         }
+        if (lfail) {
+#pragma omp atomic write
+            fail = 1;
+        }
+#pragma omp barrier
+#pragma omp single
+        {
+            for (size_t i = 0; i < nquery && !fail; i++)
+                l->start[i + 1] += l->start[i];
+            npairs = fail ? 0 : l->start[nquery];
+            size_t c1 = l->cap_pairs, c2 = l->cap_pairs;
+            if (!fail && (grow((void **)&l->j, &c1, npairs + 1, sizeof(int)) ||
+                          grow((void **)&l->r2, &c2, npairs + 1, sizeof(double))))
+                fail = 2;
+            else if (!fail)
+                l->cap_pairs = c1 < c2 ? c1 : c2;
+        }
+        if (!fail && used > 0) {
+            memcpy(l->j + l->start[lo], jb, used * sizeof *jb);
+            memcpy(l->r2 + l->start[lo], rb, used * sizeof *rb);
+        }
+        free(jb);
+        free(rb);
+        free(jt);
+        free(rt);
     }
+    if (fail)
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
+                           fail == 2 ? " for the pairs" : "");
     return MPS_OK;
 }
 
@@ -234,6 +341,46 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_n
             }
         }
     }
+    return MPS_OK;
+}
+
+enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+                                     size_t from_lo, size_t from_hi, size_t to_lo, size_t to_hi,
+                                     struct mps_err *err)
+{
+    const size_t n = src->n;
+    if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
+    dst->n = n;
+    dst->radius = src->radius;
+    memset(dst->start, 0, (n + 1) * sizeof *dst->start);
+    for (size_t i = from_lo; i < from_hi; i++)
+        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+            size_t j = (size_t)src->j[k];
+            if (j >= to_lo && j < to_hi)
+                dst->start[j + 1]++;
+        }
+    for (size_t i = 0; i < n; i++)
+        dst->start[i + 1] += dst->start[i];
+    size_t npairs = dst->start[n], cap = dst->cap_pairs, cap2 = dst->cap_pairs;
+    if (grow((void **)&dst->j, &cap, npairs + 1, sizeof(int)) ||
+        grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
+    dst->cap_pairs = cap < cap2 ? cap : cap2;
+    /* Filling in increasing i keeps each row sorted; start[j] walks to the
+     * end of row j and is shifted back afterwards. */
+    for (size_t i = from_lo; i < from_hi; i++)
+        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+            size_t j = (size_t)src->j[k];
+            if (j >= to_lo && j < to_hi) {
+                size_t m = dst->start[j]++;
+                dst->j[m] = (int)i;
+                dst->r2[m] = src->r2[k];
+            }
+        }
+    for (size_t j = n; j > 0; j--)
+        dst->start[j] = dst->start[j - 1];
+    dst->start[0] = 0;
     return MPS_OK;
 }
 

@@ -19,7 +19,9 @@ struct mps_nbr_grid {
     size_t *cell_start;   /* ncells + 1 offsets into sorted */
     size_t *sorted;       /* particle indices, grouped by cell */
     size_t *cell_of;      /* cell index of each particle */
-    size_t n, cap_n, cap_cells;
+    double (*xs)[MPS_DIM]; /* positions in the order of sorted[]: a query
+                            * reads its candidates contiguously */
+    size_t n, cap_n, cap_cells, cap_xs;
 };
 
 struct mps_nbr_list {
@@ -43,6 +45,20 @@ void mps_nbr_grid_free(struct mps_nbr_grid *g);
 enum mps_status mps_nbr_list_build(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
                                    const double (*x)[MPS_DIM], size_t nquery, double radius,
                                    struct mps_err *err);
+/* As mps_nbr_list_build, but only particles with query[i] set (all if query
+ * is NULL) get their neighbours; the others get an empty row. A fluid keeps
+ * the fixed tank out of the queries: its walls need far fewer pairs than a
+ * full search around each wall particle would give (mps_nbr_list_reverse). */
+enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
+                                          const double (*x)[MPS_DIM], size_t nquery,
+                                          const unsigned char *query, double radius,
+                                          struct mps_err *err);
+/* The transpose of part of src: row j of dst (to_lo <= j < to_hi) lists the
+ * i in [from_lo, from_hi) whose row of src holds j, sorted by i, with src's
+ * r2; all other rows of dst are empty. dst has src->n rows. */
+enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+                                     size_t from_lo, size_t from_hi, size_t to_lo, size_t to_hi,
+                                     struct mps_err *err);
 void mps_nbr_list_free(struct mps_nbr_list *l);
 
 /* The pairs of src that are closer than radius at positions x (which may have

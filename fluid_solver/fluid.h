@@ -48,6 +48,7 @@ struct fluid {
     unsigned char *surface; /* free surface (P = 0) */
     unsigned char *has_p;   /* carries a pressure: fluid, wall, solid surface */
     unsigned char *is_fluid;
+    unsigned char *nbr_query; /* gets a row in nl: not a tank particle (Neumann walls) */
     unsigned char *fallback; /* corrected gradient fell back to Eq. 9 */
     size_t nfluid, nfixed_end;
     /* lattice constants */
@@ -59,6 +60,8 @@ struct fluid {
     struct mps_nbr_grid grid;
     struct mps_nbr_list nl;       /* re_lap + skin, built at x^n */
     struct mps_nbr_list nl_n;     /* re_n, filtered from nl at x* */
+    struct mps_nbr_list nl_tank;  /* Neumann walls: the fluid neighbours of each tank
+                                   * particle (nl has no rows for them) */
     double *wlap;                 /* Laplacian weight of each nl pair at x* (PPE) */
     size_t cap_wlap;
     double skin;

@@ -205,8 +205,10 @@ void fluid_ppe_boundary_pressure(struct fluid *f)
 #pragma omp parallel for schedule(static)
     for (size_t b = f->nfluid; b < n; b++) {
         double s = 0.0, ws = 0.0;
-        for (size_t k = f->nl.start[b]; k < f->nl.start[b + 1]; k++) {
-            int j = f->nl.j[k];
+        /* a tank particle's fluid neighbours are in nl_tank, a solid's in nl */
+        const struct mps_nbr_list *l = f->nbr_query[b] ? &f->nl : &f->nl_tank;
+        for (size_t k = l->start[b]; k < l->start[b + 1]; k++) {
+            int j = l->j[k];
             if (!f->is_fluid[j])
                 continue;
             double dx[MPS_DIM], r2 = 0.0, gx = 0.0;

@@ -33,7 +33,7 @@ enum mps_status fluid_ppe_solve(struct fluid *f, struct fluid_linsolve_stats *st
 
 /* Neumann walls: sets the pressure of every boundary particle (wall, dummy,
  * solid) from the fluid pressures around it, extrapolated hydrostatically.
- * Needs f->nl for the boundary particles. */
+ * Needs f->nl (solid particles) and f->nl_tank (tank particles). */
 void fluid_ppe_boundary_pressure(struct fluid *f);
 /* Sets negative boundary pressures to zero (if fluid.clamp_negative), after
  * the gradient has used them: for output and the loads on a solid. */

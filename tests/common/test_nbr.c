@@ -103,6 +103,62 @@ static void test_random(void)
     free(x);
 }
 
+/* A masked build equals the full one on the queried rows and leaves the
+ * others empty; the reverse of the rows [0, nf) restricted to the columns
+ * [nf, n) is their transpose (a fluid and its tank). */
+static void test_masked_reverse(void)
+{
+    const size_t n = 1500, nf = 900;
+    const double l0 = 0.01, re = 5.0 * l0;
+    double (*x)[MPS_DIM] = malloc(n * sizeof *x);
+    unsigned char *q = malloc(n);
+    unsigned long long seed = 777;
+    for (size_t i = 0; i < n; i++) {
+        x[i][0] = 40 * l0 * urand(&seed);
+        x[i][1] = 40 * l0 * urand(&seed);
+        q[i] = i < nf || i % 7 == 0; /* the fluid and a few of the rest */
+    }
+    const double (*cx)[MPS_DIM] = (const double(*)[MPS_DIM])x;
+    struct mps_nbr_grid g = {0};
+    struct mps_nbr_list full = {0}, part = {0}, rev = {0};
+    struct mps_err err = {0};
+    CHECK(mps_nbr_grid_build(&g, n, cx, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&full, &g, cx, n, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build_masked(&part, &g, cx, n, q, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_reverse(&rev, &full, 0, nf, nf, n, &err) == MPS_OK);
+    CHECK(part.n == n && rev.n == n);
+    size_t bad = 0, tank_pairs = 0;
+    for (size_t i = 0; i < n; i++) {
+        size_t m = part.start[i + 1] - part.start[i];
+        if (!q[i]) {
+            bad += m != 0;
+        } else {
+            bad += m != full.start[i + 1] - full.start[i];
+            for (size_t k = 0; k < m && k < full.start[i + 1] - full.start[i]; k++)
+                bad += part.j[part.start[i] + k] != full.j[full.start[i] + k] ||
+                       part.r2[part.start[i] + k] != full.r2[full.start[i] + k];
+        }
+        /* rev row i: the i' < nf whose full row holds i, ascending */
+        size_t k = rev.start[i];
+        for (size_t a = 0; a < nf && i >= nf; a++)
+            for (size_t b = full.start[a]; b < full.start[a + 1]; b++)
+                if ((size_t)full.j[b] == i) {
+                    bad += k >= rev.start[i + 1] || (size_t)rev.j[k] != a || rev.r2[k] != full.r2[b];
+                    k++;
+                }
+        bad += k != rev.start[i + 1];
+        tank_pairs += i >= nf ? rev.start[i + 1] - rev.start[i] : 0;
+    }
+    CHECK(bad == 0);
+    CHECK(tank_pairs > 1000); /* the test sees pairs, not only empty rows */
+    mps_nbr_list_free(&full);
+    mps_nbr_list_free(&part);
+    mps_nbr_list_free(&rev);
+    mps_nbr_grid_free(&g);
+    free(q);
+    free(x);
+}
+
 /* Lattice with particles exactly on cell borders: the grid starts half a
  * cell below the lowest particle, so with cell = 2 l0 every odd lattice line
  * and with cell = 4 l0 every even one lies on a border. */
@@ -209,6 +265,7 @@ static void test_kernel(void)
 int main(void)
 {
     test_random();
+    test_masked_reverse();
     test_lattice(1.0, 0.0);
     test_lattice(0.01, -0.35);
     test_errors();

@@ -153,18 +153,28 @@ static void test_verlet_list(void)
         }
         if (4.0 * m2 > f->skin * f->skin)
             continue;
-        /* brute force: every pair within re_lap must be in the list */
-        size_t missing = 0;
+        /* brute force: every pair within re_lap must be in the list; a tank
+         * particle (no row in nl with Neumann walls) must find its fluid
+         * neighbours in nl_tank */
+        size_t missing = 0, tank_pairs = 0;
         for (size_t i = 0; i < f->ps.n; i++)
             for (size_t j = 0; j < f->ps.n; j++) {
                 double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
                 if (i == j || dx * dx + dy * dy >= re * re)
                     continue;
+                const struct mps_nbr_list *l = &f->nl;
+                if (!f->nbr_query[i]) {
+                    if (!f->is_fluid[j])
+                        continue;
+                    l = &f->nl_tank;
+                    tank_pairs++;
+                }
                 int found = 0;
-                for (size_t q = f->nl.start[i]; q < f->nl.start[i + 1] && !found; q++)
-                    found = (size_t)f->nl.j[q] == j;
+                for (size_t q = l->start[i]; q < l->start[i + 1] && !found; q++)
+                    found = (size_t)l->j[q] == j;
                 missing += !found;
             }
+        CHECK(tank_pairs > 0);
         CHECK(missing == 0);
         checked++;
     }
