@@ -43,6 +43,9 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "has_p", 1, MPS_U8, (void **)&f->has_p, "", 0);
     mps_particles_add_field(ps, "is_fluid", 1, MPS_U8, (void **)&f->is_fluid, "", 0);
     mps_particles_add_field(ps, "nbr_query", 1, MPS_U8, (void **)&f->nbr_query, "", 0);
+    mps_particles_add_field(ps, "unknown", 1, MPS_U8, (void **)&f->unknown, "", 0);
+    mps_particles_add_field(ps, "ghost", 1, MPS_U8, (void **)&f->ghost, "", 0);
+    mps_particles_add_field(ps, "grad_use", 1, MPS_U8, (void **)&f->grad_use, "", 0);
     mps_particles_add_field(ps, "grad_fallback", 1, MPS_U8, (void **)&f->fallback, "", 0);
 }
 
@@ -52,12 +55,29 @@ void fluid_update_masks(struct fluid *f)
      * but its own pressure, which only needs the fluid around it
      * (fluid_ppe_boundary_pressure): nl_tank has those. The tank is 40% of
      * the particles of the 3 mm dam break. */
-    const int tank_rows = f->prm.wall_bc != FLUID_WALL_NEUMANN;
+    const enum fluid_wall_bc bc = f->prm.wall_bc;
     for (size_t i = 0; i < f->ps.n; i++) {
         int t = f->type[i];
+        int tank = t == WALL_P || t == DUMMY_P, solid = t == SOLID_SURF_P || t == SOLID_INNER_P;
         f->is_fluid[i] = t == FLUID_P;
         f->has_p[i] = t == FLUID_P || t == WALL_P || t == SOLID_SURF_P;
-        f->nbr_query[i] = tank_rows || (t != WALL_P && t != DUMMY_P);
+        f->nbr_query[i] = bc == FLUID_WALL_PPE || !tank;
+        switch (bc) {
+        case FLUID_WALL_NEUMANN:
+            f->unknown[i] = t == FLUID_P;
+            f->ghost[i] = tank || solid;
+            break;
+        case FLUID_WALL_PPE:
+            f->unknown[i] = f->has_p[i];
+            f->ghost[i] = 0;
+            break;
+        case FLUID_WALL_SOLID_PPE:
+            f->unknown[i] = t == FLUID_P || t == SOLID_SURF_P;
+            f->ghost[i] = tank;
+            break;
+        }
+        /* the paper's dummies and inner solid particles carry no pressure */
+        f->grad_use[i] = f->unknown[i] || f->ghost[i];
     }
 }
 
@@ -207,7 +227,7 @@ static enum mps_status build_neighbours(struct fluid *f, struct mps_err *err)
     memcpy(f->xref, f->x, f->ps.n * sizeof *f->x);
     st = mps_nbr_list_build_masked(&f->nl, &f->grid, (const double(*)[MPS_DIM])f->x, f->ps.n,
                                    f->nbr_query, radius, err);
-    if (st || f->prm.wall_bc != FLUID_WALL_NEUMANN)
+    if (st || f->prm.wall_bc == FLUID_WALL_PPE)
         return st;
     return mps_nbr_list_reverse(&f->nl_tank, &f->nl, 0, f->nfluid, f->nfluid, f->nfixed_end, err);
 }
@@ -565,8 +585,8 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     /* Eq. 8 at x*, and the free-surface double check (paper 4.3), for the
      * PPE unknowns: fluid (Neumann walls), or fluid, wall and solid surface */
     mps_timer_switch(&f->timer, PH_DENSITY);
-    const int neumann = p->wall_bc == FLUID_WALL_NEUMANN;
-    const unsigned char *rows = neumann ? f->is_fluid : f->has_p;
+    const int ghosts = p->wall_bc != FLUID_WALL_PPE;
+    const unsigned char *rows = f->unknown;
     struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
     mps_ops_number_density(&nd_in, f->nd, f->ncount);
     const double nlim = p->beta1 * f->n0, clim = p->beta2 * f->count0;
@@ -578,14 +598,13 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 
     if (p->mixed_source) {
         /* Eq. 10 on v*: fixed particles have v* = 0, solid ones their
-         * velocity. With Neumann walls the boundary also takes the kick
-         * dt g, since its extrapolated pressure holds the fluid against
-         * gravity: fluid at rest on a wall then has no divergence. */
-        const double kick = neumann ? dt : 0.0;
+         * velocity. A Neumann (ghost) boundary also takes the kick dt g,
+         * since its extrapolated pressure holds the fluid against gravity:
+         * fluid at rest on a wall then has no divergence. */
 #pragma omp parallel for schedule(static)
         for (size_t i = nf; i < n; i++)
             for (int d = 0; d < MPS_DIM; d++)
-                f->vstar[i][d] = f->v[i][d] + kick * p->g[d];
+                f->vstar[i][d] = f->v[i][d] + (f->ghost[i] ? dt : 0.0) * p->g[d];
         struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
         mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
     }
@@ -604,10 +623,9 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 
     /* Eq. 14-15 (or 9), Eq. 19 and 24 */
     mps_timer_switch(&f->timer, PH_CORRECT);
-    if (neumann)
+    if (ghosts)
         fluid_ppe_boundary_pressure(f);
-    struct mps_ops_in g_in = {&f->nl_n, x, p->re_n * p->dp, neumann ? NULL : f->has_p,
-                              f->is_fluid};
+    struct mps_ops_in g_in = {&f->nl_n, x, p->re_n * p->dp, f->grad_use, f->is_fluid};
     if (p->gradient == FLUID_GRAD_CORRECTED)
         mps_ops_gradient_corrected(&g_in, f->n0, f->p, p->gradient_min, 0.2, f->grad,
                                    f->fallback);
@@ -623,7 +641,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
         }
 
     shift(f, dt);
-    if (neumann)
+    if (ghosts)
         fluid_ppe_boundary_clamp(f);
     mps_timer_switch(&f->timer, PH_OTHER);
     f->time += dt;

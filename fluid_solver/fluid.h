@@ -7,7 +7,9 @@
  * Boundary pressure (fluid.wall_bc): with Neumann walls (default) only fluid
  * particles are PPE unknowns and every boundary particle takes the fluid's
  * pressure extrapolated hydrostatically; with the paper's walls the wall
- * and solid surface particles are PPE unknowns and dummies carry none.
+ * and solid surface particles are PPE unknowns and dummies carry none;
+ * solid_ppe puts the solid surface in the PPE (the paper's coupling) and
+ * keeps Neumann tank walls. fluid_update_masks() says who is what.
  * docs/fluid.md describes the step and every deviation from the paper. */
 #ifndef FLUID_H
 #define FLUID_H
@@ -49,6 +51,10 @@ struct fluid {
     unsigned char *has_p;   /* carries a pressure: fluid, wall, solid surface */
     unsigned char *is_fluid;
     unsigned char *nbr_query; /* gets a row in nl: not a tank particle (Neumann walls) */
+    unsigned char *unknown;   /* a PPE unknown unless on the free surface */
+    unsigned char *ghost;     /* boundary whose pressure a PPE row extrapolates from
+                               * itself, P_j = P_i + rho g.(x_j - x_i) (Neumann) */
+    unsigned char *grad_use;  /* carries a pressure the gradient uses */
     unsigned char *fallback; /* corrected gradient fell back to Eq. 9 */
     size_t nfluid, nfixed_end;
     /* lattice constants */

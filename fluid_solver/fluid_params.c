@@ -37,9 +37,11 @@ const struct mps_key_spec fluid_case_keys[] = {
      "of the point dp outside it (0: the paper's double check alone)"},
     {"fluid.gradient", MPS_KEY_ENUM, "corrected", 0, 0, 0, "corrected|plain", "",
      "pressure gradient: Eq. 14-15 (corrected) or Eq. 9 (plain)"},
-    {"fluid.wall_bc", MPS_KEY_ENUM, "neumann", 0, 0, 0, "neumann|ppe", "",
-     "wall pressure: Neumann condition by hydrostatic extrapolation from the fluid, or the "
-     "first wall layer solved in the PPE (paper 4.3), see docs/fluid.md"},
+    {"fluid.wall_bc", MPS_KEY_ENUM, "solid_ppe", 0, 0, 0, "solid_ppe|neumann|ppe", "",
+     "wall pressure: Neumann tank walls (hydrostatic extrapolation from the fluid) and a "
+     "coupled solid's surface in the PPE (solid_ppe), Neumann for the solid too (neumann), "
+     "or the first wall layer and the solid surface in the PPE (ppe, the paper's 4.3); "
+     "see docs/fluid.md"},
     {"fluid.surface_laplacian", MPS_KEY_ENUM, "closed", 0, 0, 0, "closed|truncated", "",
      "PPE Laplacian of the particles under the free surface (Neumann walls only): "
      "neighbours missing beyond the surface extrapolated to P = 0 there (closed), or left "
@@ -125,10 +127,12 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->gradient = strcmp(mps_case_string(c, "fluid.gradient"), "plain") == 0
                       ? FLUID_GRAD_PLAIN
                       : FLUID_GRAD_CORRECTED;
-    p->wall_bc = strcmp(mps_case_string(c, "fluid.wall_bc"), "ppe") == 0 ? FLUID_WALL_PPE
-                                                                           : FLUID_WALL_NEUMANN;
+    const char *wbc = mps_case_string(c, "fluid.wall_bc");
+    p->wall_bc = strcmp(wbc, "ppe") == 0         ? FLUID_WALL_PPE
+                 : strcmp(wbc, "solid_ppe") == 0 ? FLUID_WALL_SOLID_PPE
+                                                 : FLUID_WALL_NEUMANN;
     p->surface_closure = strcmp(mps_case_string(c, "fluid.surface_laplacian"), "closed") == 0 &&
-                         p->wall_bc == FLUID_WALL_NEUMANN;
+                         p->wall_bc != FLUID_WALL_PPE;
     p->gradient_min = mps_case_bool(c, "fluid.gradient_min");
     p->clamp_negative = mps_case_bool(c, "fluid.clamp_negative");
     p->collision_dist = mps_case_double(c, "fluid.collision_distance");

@@ -14,7 +14,7 @@ enum fluid_gradient { FLUID_GRAD_CORRECTED, FLUID_GRAD_PLAIN };
 /* Pressure at fixed and solid boundaries: wall particles as PPE unknowns
  * (paper 4.3), or a Neumann condition by hydrostatic extrapolation from the
  * fluid (docs/fluid.md). */
-enum fluid_wall_bc { FLUID_WALL_NEUMANN, FLUID_WALL_PPE };
+enum fluid_wall_bc { FLUID_WALL_NEUMANN, FLUID_WALL_PPE, FLUID_WALL_SOLID_PPE };
 
 
 

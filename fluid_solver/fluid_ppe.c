@@ -27,22 +27,24 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
  * Neumann walls: fluid neighbours enter as unknowns (or P = 0 on the free
  * surface); boundary neighbours (wall, dummy, solid) take the pressure
  * P_j = P_i + rho g.(x_j - x_i), so their P_i - P_j is known and goes to
- * the right-hand side (pass 2), not to the diagonal. */
+ * the right-hand side (pass 2), not to the diagonal.
+ * solid_ppe: the solid surface as in the paper, the tank as with Neumann
+ * walls. f->unknown and f->ghost (fluid_update_masks) hold who is which. */
 static int row_weights(struct fluid *f, size_t i, double c, double *diag)
 {
     const double re = f->prm.re_lap * f->prm.dp, re2 = re * re;
-    const int neumann = f->prm.wall_bc == FLUID_WALL_NEUMANN;
+    const int ghosts = f->prm.wall_bc != FLUID_WALL_PPE;
     int m = 0;
     double dsum = 0.0, mom[2] = {0.0, 0.0}, srf[2] = {0.0, 0.0}, ws = 0.0;
     for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
         int j = f->nl.j[k];
         double cw = 0.0;
-        if (neumann || f->has_p[j]) {
+        if (f->unknown[j] || f->ghost[j]) {
             double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
             double r2 = dx * dx + dy * dy;
             if (r2 < re2) {
                 cw = c * mps_weight(sqrt(r2), re);
-                if (!neumann || f->is_fluid[j]) {
+                if (f->unknown[j]) {
                     dsum += cw;
                     /* same predicate as pass 2: r == re rounds to w = 0 */
                     m += cw > 0.0 && f->row[j] >= 0;
@@ -59,7 +61,7 @@ static int row_weights(struct fluid *f, size_t i, double c, double *diag)
         f->wlap[k] = cw;
     }
     double mn = sqrt(mom[0] * mom[0] + mom[1] * mom[1]);
-    if (neumann && f->prm.surface_closure && ws > 0.0 && mn > 0.0) {
+    if (ghosts && f->prm.surface_closure && ws > 0.0 && mn > 0.0) {
         /* Free-surface closure: the neighbours missing beyond the free surface
          * would contribute sum_missing c w (P_j - P_i) = -grad P . m_i for a
          * linear field, with m_i = sum_present c w r_ij (the full lattice sums
@@ -82,9 +84,9 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     const struct fluid_params *p = &f->prm;
     const size_t n = f->ps.n;
     int nrows = 0;
-    const int neumann = p->wall_bc == FLUID_WALL_NEUMANN;
+    const int ghosts = p->wall_bc != FLUID_WALL_PPE;
     for (size_t i = 0; i < n; i++)
-        f->row[i] = ((neumann ? f->is_fluid[i] : f->has_p[i]) && !f->surface[i]) ? nrows++ : -1;
+        f->row[i] = (f->unknown[i] && !f->surface[i]) ? nrows++ : -1;
     f->nrows = nrows;
 
     size_t rcap = f->cap_rows;
@@ -141,7 +143,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
             if (f->row[j] >= 0) {
                 cols[q] = f->row[j];
                 vals[q++] = -f->wlap[k];
-            } else if (neumann && !f->is_fluid[j]) {
+            } else if (f->ghost[j]) {
                 /* c w_ij (P_j - P_i) = c w_ij rho g.(x_j - x_i), to the right */
                 double gx = 0.0;
                 for (int d = 0; d < MPS_DIM; d++)
@@ -162,7 +164,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         f->rhs[r] = ghost + src * dn;
         if (mixed) /* with Neumann walls compressibility acts on the change of
                     * pressure, see fluid_ppe.h */
-            f->rhs[r] += (neumann ? comp * f->p[i] : 0.0) - f->div[i] * div_coef;
+            f->rhs[r] += (ghosts ? comp * f->p[i] : 0.0) - f->div[i] * div_coef;
         f->sol[r] = f->p[i]; /* warm start */
     }
     return MPS_OK;
@@ -204,6 +206,8 @@ void fluid_ppe_boundary_pressure(struct fluid *f)
      * dam-break runs failed sooner, docs/fluid.md). */
 #pragma omp parallel for schedule(static)
     for (size_t b = f->nfluid; b < n; b++) {
+        if (!f->ghost[b])
+            continue; /* a PPE unknown (solid_ppe: the solid surface) or no pressure */
         double s = 0.0, ws = 0.0;
         /* a tank particle's fluid neighbours are in nl_tank, a solid's in nl */
         const struct mps_nbr_list *l = f->nbr_query[b] ? &f->nl : &f->nl_tank;

@@ -2,13 +2,14 @@
  * (Eq. 23). Unknowns are the particles that carry a pressure and are not on
  * the free surface (P = 0 there): fluid only with Neumann walls
  * (fluid.wall_bc = neumann), fluid, wall and solid surface particles with the
- * paper's walls (ppe). With the Laplacian of Eq. 12 the system reads, for
+ * paper's walls (ppe), fluid and solid surface with solid_ppe (Neumann tank
+ * walls, the paper's coupling to the solid). With the Laplacian of Eq. 12 the system reads, for
  * each unknown i,
  *   c sum_j w_ij (P_i - P_j) + (rho alpha / dt^2) P_i = rhs_i,  c = 2d/(lambda n0),
  * symmetric, positive definite, diagonally dominant.
  * rhs_i, density source (Eq. 23): kappa rho/dt^2 (n*_i - n0)/n0.
  * rhs_i, mixed source: the same plus -(rho/dt) div v*_i, and with Neumann
- *   walls + (rho alpha/dt^2) P^n_i: continuity with the equation of state
+ *   walls (also solid_ppe) + (rho alpha/dt^2) P^n_i: continuity with the equation of state
  *   (Eq. 21) over one step, alpha (P^{n+1} - P^n)/dt = -div v^{n+1}, so
  *   compressibility acts on the change of pressure and still water keeps its
  *   pressure from step to step. With the density source alone (and with the
