@@ -14,7 +14,9 @@
  * next step's matrix (warm rows use it; same n expected), default A/b.
  * --synthetic N: jittered-lattice MPS matrix with about N rows (see
  * synth_build); the warm matrix has every particle moved a little, so its
- * pattern differs as after a real time step. */
+ * pattern differs as after a real time step.
+ * A method written NAME@THETA (pcg_sic0@0.02) runs with that drop threshold
+ * (fluid_linsolve_set_drop), so several thresholds fit in one --methods. */
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
@@ -510,7 +512,7 @@ static int solve_timed(struct fluid_linsolve *s, const struct mat *m, const doub
 static void print_row(const char *method, const char *start, const struct mat *m,
                       const struct run *r)
 {
-    printf("| %-13s | %-4s | %6d | %5.1f | %8.2f | %8.2f | %8.2f | %5d | %8.2f | %8.1e |\n",
+    printf("| %-15s | %-4s | %6d | %5.1f | %8.2f | %8.2f | %8.2f | %5d | %8.2f | %8.1e |\n",
            method, start, m->n, (double)m->rowptr[m->n] / m->n, 1e3 * r->st.t_analyse,
            1e3 * r->st.t_factor, 1e3 * r->st.t_solve, r->st.iterations, 1e3 * r->total,
            r->check);
@@ -523,7 +525,8 @@ static void usage(void)
             "       linsolve_bench [options] --synthetic N\n"
             "options:\n"
             "  --methods LIST  comma-separated, from: %s\n"
-            "                  (default pcg_jacobi,pcg_ic0,cholmod,cholmod_reuse)\n"
+            "                  (default pcg_jacobi,pcg_ic0,cholmod,cholmod_reuse);\n"
+            "                  NAME@THETA sets the drop threshold (pcg_sic0@0.02)\n"
             "  --repeat K      runs per measurement, fastest kept (default 3)\n"
             "  --threads T     OpenMP threads, 0 = default (default 0)\n"
             "  --rtol R        relative residual for PCG (default 1e-6, as fluid.ppe_rtol)\n"
@@ -533,7 +536,9 @@ static void usage(void)
             "                  default fluid.alpha and dt = 1e-3..2e-4 s)\n"
             "  --step D        synthetic: particle motion between the two matrices, in\n"
             "                  particle spacings (default 0.02)\n"
-            "  --shuffle       synthetic: number the unknowns randomly (no locality)\n",
+            "  --shuffle       synthetic: number the unknowns randomly (no locality)\n"
+            "  --warm-noise E  relative noise on b for the warm start (default 1e-3;\n"
+            "                  larger: a worse initial guess, more warm iterations)\n",
             fluid_linsolve_methods());
     exit(2);
 }
@@ -543,7 +548,7 @@ int main(int argc, char **argv)
     setvbuf(stdout, NULL, _IOLBF, 0);   /* rows appear as they are measured */
     const char *methods = "pcg_jacobi,pcg_ic0,cholmod,cholmod_reuse";
     int repeat = 3, threads = 0, max_iter = 20000, synthetic = 0, shuffle = 0;
-    double rtol = 1e-6, eps = 1e-3, step = 0.02;
+    double rtol = 1e-6, eps = 1e-3, step = 0.02, warm_noise = 1e-3;
     const char *files[4] = {NULL, NULL, NULL, NULL};
     int nfiles = 0;
     for (int a = 1; a < argc; a++) {
@@ -565,6 +570,8 @@ int main(int argc, char **argv)
             step = atof(argv[++a]);
         else if (!strcmp(o, "--synthetic") && more)
             synthetic = atoi(argv[++a]);
+        else if (!strcmp(o, "--warm-noise") && more)
+            warm_noise = atof(argv[++a]);
         else if (!strcmp(o, "--shuffle"))
             shuffle = 1;
         else if (o[0] == '-' && o[1])
@@ -629,17 +636,17 @@ int main(int argc, char **argv)
         load[strcspn(load, "\n")] = '\0';
         fclose(lf);
     }
-    printf("threads %d, rtol %g, min of %d runs, load average before: %s\n", nthr, rtol,
-           repeat, load);
+    printf("threads %d, rtol %g, warm noise %g, min of %d runs, load average before: %s\n",
+           nthr, rtol, warm_noise, repeat, load);
 
-    /* Warm start: the solution for b1 * (1 + 1e-3 noise). Solved with PCG to
+    /* Warm start: the solution for b1 * (1 + warm_noise * noise). Solved with PCG to
      * a tight tolerance rather than with CHOLMOD: OpenBLAS threads left
      * spinning by a factorisation would slow the first timed PCG runs. */
     double *xwarm = xmalloc((size_t)A1.n * sizeof *xwarm);
     {
         double *bp = xmalloc((size_t)A1.n * sizeof *bp);
         for (int i = 0; i < A1.n; i++)
-            bp[i] = b1[i] * (1.0 + 1e-3 * (2.0 * urand() - 1.0));
+            bp[i] = b1[i] * (1.0 + warm_noise * (2.0 * urand() - 1.0));
         struct fluid_linsolve *s = NULL;
         struct mps_err err = {0};
         memset(xwarm, 0, (size_t)A1.n * sizeof *xwarm);
@@ -654,9 +661,9 @@ int main(int argc, char **argv)
         free(bp);
     }
 
-    printf("\n| method        | start|      n | nnz/r | analyse  | factor   | solve    | iters "
-           "| total    | residual |\n");
-    printf("|---------------|------|--------|-------|----------|----------|----------|-------"
+    printf("\n| method          | start|      n | nnz/r | analyse  | factor   | solve    | "
+           "iters | total    | residual |\n");
+    printf("|-----------------|------|--------|-------|----------|----------|----------|-------"
            "|----------|----------|\n");
     double *x = xmalloc((size_t)(A0.n > A1.n ? A0.n : A1.n) * sizeof *x);
     char *list = strdup(methods);
@@ -666,10 +673,22 @@ int main(int argc, char **argv)
         struct run best[2] = {0}, r;
         best[0].total = best[1].total = INFINITY;
         int ok = 1;
+        char label[64];
+        snprintf(label, sizeof label, "%s", name);
+        char *at = strchr(name, '@');
+        double theta = 0.0;
+        if (at) {
+            char *end;
+            *at = '\0';
+            theta = strtod(at + 1, &end);
+            if (end == at + 1 || *end)
+                die("method \"%s\": expected NAME@THETA with a number after @", label);
+        }
         for (int k = 0; k < repeat && ok; k++) {
             struct fluid_linsolve *s = NULL;
             struct mps_err err = {0};
-            if (fluid_linsolve_create(&s, name, rtol, max_iter, threads, &err))
+            if (fluid_linsolve_create(&s, name, rtol, max_iter, threads, &err) ||
+                (at && fluid_linsolve_set_drop(s, theta, &err)))
                 die("%s", err.msg);
             memset(x, 0, (size_t)A0.n * sizeof *x);
             ok = !solve_timed(s, &A0, b0, x, &r);
@@ -685,8 +704,8 @@ int main(int argc, char **argv)
             failed = 1;
             continue;
         }
-        print_row(name, "cold", &A0, &best[0]);
-        print_row(name, "warm", &A1, &best[1]);
+        print_row(label, "cold", &A0, &best[0]);
+        print_row(label, "warm", &A1, &best[1]);
         fflush(stdout);
     }
     free(list);

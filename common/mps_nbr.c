@@ -237,10 +237,31 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
     l->start[0] = 0;
     int fail = 0;
     size_t npairs = 0;
-#pragma omp parallel
+    /* Threads take contiguous blocks with equal numbers of queried rows: a
+     * fluid queries its first particles only, and an even split by index
+     * gave one thread nearly all the work. */
+    const int ntmax = omp_get_max_threads();
+    size_t *bound = malloc(((size_t)ntmax + 1) * sizeof *bound);
+    if (!bound)
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
+    size_t nq = 0;
+    for (size_t i = 0; i < nquery; i++)
+        nq += !query || query[i];
+    bound[0] = 0;
+    for (size_t i = 0, seen = 0, t = 1; t <= (size_t)ntmax; t++) {
+        size_t want = nq * t / (size_t)ntmax;
+        while (i < nquery && seen < want)
+            seen += !query || query[i++];
+        bound[t] = t == (size_t)ntmax ? nquery : i;
+    }
+#pragma omp parallel num_threads(ntmax)
     {
         int nt = omp_get_num_threads(), t = omp_get_thread_num();
-        size_t lo = nquery * (size_t)t / (size_t)nt, hi = nquery * (size_t)(t + 1) / (size_t)nt;
+        size_t lo = bound[t], hi = bound[t + 1];
+        if (nt != ntmax) { /* fewer threads than asked for: split by index */
+            lo = nquery * (size_t)t / (size_t)nt;
+            hi = nquery * (size_t)(t + 1) / (size_t)nt;
+        }
         int *jb = NULL, *jt = NULL;
         double *rb = NULL, *rt = NULL;
         size_t cap = 0, capt = 0, capt2 = 0, cap2 = 0, used = 0;
@@ -287,6 +308,7 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
         free(jt);
         free(rt);
     }
+    free(bound);
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
                            fail == 2 ? " for the pairs" : "");
@@ -304,7 +326,7 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_n
     dst->n = n;
     dst->radius = radius;
     dst->start[0] = 0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++) {
         size_t m = 0;
         for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
@@ -325,7 +347,7 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_n
         grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
     dst->cap_pairs = cap < cap2 ? cap : cap2;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++) {
         size_t m = dst->start[i];
         for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {

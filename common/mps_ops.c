@@ -11,7 +11,7 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -42,7 +42,7 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re, coef = 2.0 * MPS_DIM / (lambda * n0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -72,7 +72,7 @@ void mps_ops_laplacian(const struct mps_ops_in *in, double n0, double lambda, co
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re, coef = 2.0 * MPS_DIM / (lambda * n0);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -155,7 +155,7 @@ void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, i
 {
     const struct mps_nbr_list *nl = in->nl;
     const double coef = MPS_DIM / n0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -175,7 +175,7 @@ void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const do
 #if MPS_DIM == 2
     /* On a full lattice M = (1/n) sum e(x)e w = I/d, so det M = 1/d^2. */
     const double det_full = 1.0 / (MPS_DIM * MPS_DIM);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -214,7 +214,7 @@ void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re, coef = MPS_DIM / n0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;

@@ -152,6 +152,8 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     f->skin = SKIN_FRACTION * prm->dp;
 
     st = fluid_linsolve_create(&f->ls, prm->ppe_solver, prm->ppe_rtol, prm->ppe_max_iter, 0, err);
+    if (!st)
+        st = fluid_linsolve_set_drop(f->ls, prm->ppe_drop, err);
     if (st)
         goto fail;
     *out = f;

@@ -11,11 +11,15 @@
 
 #include <cholmod.h>
 
-enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE };
+enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE, M_PCG_SIC0 };
 
-static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse"};
+static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse",
+                                           "pcg_sic0"};
 
-/* "auto" = pcg_ic0. Measured with bench/linsolve_bench on the synthetic PPE
+/* "auto" = pcg_sic0 since the real PPE of the 3 mm dam break was measured
+ * (docs/ppe_solvers.md): the same iterations' worth of accuracy for 19% less
+ * PPE time on one thread, 22% on two (the factor of the pruned matrix costs
+ * half). Before that, pcg_ic0, from these synthetic figures. Measured with bench/linsolve_bench on the synthetic PPE
  * (jittered lattice, ~46 nnz/row, rtol 1e-6, min of 3 runs; see
  * docs/ppe_solvers.md), warm-started solve in ms at n = 5k / 20k / 80k:
  *   2 threads, quiet machine: pcg_ic0 4.6 / 22 / 137, pcg_jacobi 4.3 / 24 / 111
@@ -26,9 +30,18 @@ static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "
  * ahead when the cores are shared (the usual case for a coupled run here),
  * and 3-4x fewer iterations, which keeps a margin under fluid.ppe_max_iter
  * on harder matrices. */
-#define AUTO_METHOD M_PCG_IC0
+#define AUTO_METHOD M_PCG_SIC0
 
-#define METHOD_LIST "pcg_jacobi, pcg_ic0, cholmod, cholmod_reuse, auto"
+#define METHOD_LIST "pcg_jacobi, pcg_ic0, pcg_sic0, cholmod, cholmod_reuse, auto"
+
+/* pcg_sic0's default drop threshold theta (fluid_linsolve_set_drop). On the
+ * 3 mm dam break (4.5k rows, 1 thread, real warm starts) the PPE cost per
+ * step was 6.65 ms with pcg_ic0 and 5.59 / 5.37 / 5.34 / 5.69 ms at theta =
+ * 0.01 / 0.015 / 0.02 / 0.025 (iterations 12.5 -> 16.8 / 18.2 / 19.6 /
+ * 22.8); on the 80k synthetic matrix 0.015 beat 0.02. It keeps about 9 of
+ * the 22 lower-triangle couplings of a row: the neighbours within ~2.2
+ * spacings. See docs/ppe_solvers.md. */
+#define SIC0_DEFAULT_DROP 0.015
 
 /* Below this many rows a parallel region costs more than it saves. */
 #define PAR_MIN_ROWS 4096
@@ -52,7 +65,9 @@ struct fluid_linsolve {
     size_t cap_lnz;
     int *lptr, *lcol, *mark;
     double *lval, *linv;
+    double *comp;        /* pcg_sic0: sum of the couplings dropped from each row */
     int nblk;            /* blocks of rows factorised independently (one per thread) */
+    double drop2;        /* pcg_sic0: theta^2 of the drop rule (0 for pcg_ic0) */
 
     /* CHOLMOD */
     int cm_started;
@@ -116,6 +131,13 @@ const char *fluid_linsolve_method(const struct fluid_linsolve *s)
     return s ? method_names[s->method] : "(none)";
 }
 
+/* pcg_ic0 and pcg_sic0 share the factor, its storage and its application;
+ * they differ only in the matrix factorised. */
+static inline int uses_ic0(const struct fluid_linsolve *s)
+{
+    return s->method == M_PCG_IC0 || s->method == M_PCG_SIC0;
+}
+
 /* realloc that keeps the old block on failure and raises *fail instead, so a
  * batch of arrays can be grown and checked once. */
 static void *grow(void *p, size_t count, size_t elem, int *fail)
@@ -138,11 +160,13 @@ static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struc
     s->q = grow(s->q, c, sizeof *s->q, &fail);
     s->dinv = grow(s->dinv, c, sizeof *s->dinv, &fail);
     s->diag = grow(s->diag, c, sizeof *s->diag, &fail);
-    if (s->method == M_PCG_IC0) {
+    if (uses_ic0(s)) {
         s->lptr = grow(s->lptr, c + 1, sizeof *s->lptr, &fail);
         s->mark = grow(s->mark, c, sizeof *s->mark, &fail);
         s->linv = grow(s->linv, c, sizeof *s->linv, &fail);
     }
+    if (s->method == M_PCG_SIC0)
+        s->comp = grow(s->comp, c, sizeof *s->comp, &fail);
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate work vectors for %zu rows",
                            method_names[s->method], n);
@@ -189,6 +213,7 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
     s->rtol = rtol;
     s->max_iter = max_iter;
     s->perm_n = -1;
+    s->drop2 = m == M_PCG_SIC0 ? SIC0_DEFAULT_DROP * SIC0_DEFAULT_DROP : 0.0;
     s->nthreads = nthreads > 0 ? nthreads : omp_get_max_threads();
     if (s->nthreads < 1)
         s->nthreads = 1;
@@ -209,6 +234,22 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
         s->cm.error_handler = cholmod_error_capture;
     }
     *out = s;
+    return MPS_OK;
+}
+
+enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
+                                        struct mps_err *err)
+{
+    if (!s)
+        return mps_err_set(err, MPS_EINPUT, "fluid_linsolve_set_drop: NULL solver");
+    /* theta >= 1 would drop every coupling of a diagonally dominant matrix
+     * (|a_ij| <= min(a_ii, a_jj)) and leave the row sums alone on the
+     * diagonal: a much worse preconditioner than Jacobi. */
+    if (!(theta >= 0.0 && theta < 1.0))
+        return mps_err_set(err, MPS_EINPUT, "%s: drop threshold theta = %g: must be in [0, 1)",
+                           method_names[s->method], theta);
+    if (s->method == M_PCG_SIC0)
+        s->drop2 = theta * theta;
     return MPS_OK;
 }
 
@@ -243,6 +284,7 @@ void fluid_linsolve_destroy(struct fluid_linsolve **sp)
     free(s->mark);
     free(s->lval);
     free(s->linv);
+    free(s->comp);
     free(s->perm);
     free(s->pat_ptr);
     free(s->pat_col);
@@ -500,6 +542,25 @@ static void k_direction(struct fluid_linsolve *s, int n, double beta, const doub
  * blocks, never on scheduling. */
 static inline int blk_lo(int n, int nblk, int b) { return (int)((long long)n * b / nblk); }
 
+/* Sparsified IC(0) (pcg_sic0): the factor is IC(0) of A~, which keeps the
+ * couplings with a_ij^2 >= theta^2 a_ii a_jj and adds the others to the
+ * diagonal of their row. The MPS Laplacian has ~45 neighbours within 4
+ * spacings, most of them weak (w = 4/r - 1: 3 at one spacing, 0.33 at
+ * three), and IC(0) costs (nonzeros per row)^2 to build and nonzeros per
+ * row to apply; without the weak ones CG needs more iterations, but each is
+ * cheaper and the factor much cheaper. Adding them to the diagonal keeps the
+ * row sums, so the constant and smooth modes, the slow ones for CG, stay
+ * well preconditioned (measured: partial compensation, dropped * omega with
+ * omega = 0.9 .. 0, took 5-45% more iterations than omega = 1), and A~ stays
+ * a weakly diagonally dominant M-matrix whose IC(0) exists. Compared as
+ * (a_ij / a_ii) (a_ij / a_jj), a product of the same two factors for (i, j)
+ * and (j, i): the decision is symmetric bit for bit, so A~ is symmetric
+ * whenever A is. */
+static inline int sic0_weak(const struct fluid_linsolve *s, int i, int j, double aij)
+{
+    return (aij * s->dinv[i]) * (aij * s->dinv[j]) < s->drop2;
+}
+
 /* Rows [lo, hi) of block b. Row-oriented: L_ik = (a_ik - sum_{j<k} L_ij L_kj)
  * / L_kk over the common pattern, found without a branch: mark[j] is the
  * position of L_ij for the columns of row i and otherwise a sentinel
@@ -511,16 +572,40 @@ static int ic0_factor_block(struct fluid_linsolve *s, const struct fluid_csr *A,
     int *lptr = s->lptr, *lcol = s->lcol, *mark = s->mark;
     double *lval = s->lval, *linv = s->linv;
     const int zero = lptr[A->n];
-    for (int i = lo; i < hi; i++) {   /* copy the block's lower triangle */
-        int nz = lptr[i], k = A->rowptr[i];
-        while (A->col[k] < lo)
-            k++;
-        for (; k <= s->diag[i]; k++) {
-            lcol[nz] = A->col[k];
-            lval[nz++] = A->val[k];
+    if (s->method == M_PCG_SIC0) {
+        /* The block's lower triangle of A~ (see sic0_weak), the dropped
+         * couplings (s->comp, from ic0_setup) added to the diagonal. Every
+         * entry is written and the position advances only for kept ones:
+         * no branch on a test that is true about as often as false. nz never
+         * passes the diagonal's slot, which is written last. The shift scales
+         * a_ii, not a~_ii, so that the fallback still reaches positive
+         * pivots if the compensation left a~_ii small; with nothing dropped
+         * this is pcg_ic0's diagonal bit for bit. */
+        for (int i = lo; i < hi; i++) {
+            int nz = lptr[i], k = A->rowptr[i];
+            while (A->col[k] < lo)
+                k++;
+            for (; k < s->diag[i]; k++) {
+                lcol[nz] = A->col[k];
+                lval[nz] = A->val[k];
+                nz += !sic0_weak(s, i, A->col[k], A->val[k]);
+            }
+            lcol[nz] = i;
+            lval[nz] = A->val[s->diag[i]] * (1.0 + shift) + s->comp[i];
+            mark[i] = zero;
         }
-        lval[nz - 1] *= 1.0 + shift;
-        mark[i] = zero;
+    } else {
+        for (int i = lo; i < hi; i++) {   /* copy the block's lower triangle */
+            int nz = lptr[i], k = A->rowptr[i];
+            while (A->col[k] < lo)
+                k++;
+            for (; k <= s->diag[i]; k++) {
+                lcol[nz] = A->col[k];
+                lval[nz++] = A->val[k];
+            }
+            lval[nz - 1] *= 1.0 + shift;
+            mark[i] = zero;
+        }
     }
     for (int i = lo; i < hi; i++) {
         int rlo = lptr[i], dpos = lptr[i + 1] - 1;
@@ -576,6 +661,38 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
     reduction(+ : dropped, kept)
         for (int b = 0; b < nblk; b++) {
             int lo = blk_lo(n, nblk, b), hi = blk_lo(n, nblk, b + 1);
+            if (s->method == M_PCG_SIC0) {
+                /* Only the couplings A~ keeps count, for the length and the
+                 * split. The weak ones of each row go to s->comp, read from
+                 * the lower triangle only (half the traffic of whole rows):
+                 * a weak a_ij, j < i, counts for row i and, in the same
+                 * block, for row j; row i's weak couplings to later blocks
+                 * are read from the end of its row. Branch-free where the
+                 * test is as often true as false, see ic0_factor_block. */
+                double *comp = s->comp;
+                for (int i = lo; i < hi; i++)
+                    comp[i] = 0.0;
+                for (int i = lo; i < hi; i++) {
+                    int len = 1, out = 0;
+                    double ci = 0.0;
+                    for (int k = A->rowptr[i]; k < s->diag[i]; k++) {
+                        int j = A->col[k], strong = !sic0_weak(s, i, j, A->val[k]);
+                        double w = strong ? 0.0 : A->val[k];
+                        ci += w;
+                        if (j >= lo)
+                            comp[j] += w;
+                        len += strong & (j >= lo);
+                        out += strong & (j < lo);
+                    }
+                    for (int k = A->rowptr[i + 1] - 1; A->col[k] >= hi; k--)
+                        ci += sic0_weak(s, i, A->col[k], A->val[k]) ? A->val[k] : 0.0;
+                    comp[i] += ci;
+                    lptr[i + 1] = len;
+                    kept += len - 1;
+                    dropped += out;
+                }
+                continue;
+            }
             for (int i = lo; i < hi; i++) {
                 int k = A->rowptr[i];
                 while (A->col[k] < lo)
@@ -604,8 +721,8 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
         s->lcol = grow(s->lcol, c, sizeof *s->lcol, &fail);
         s->lval = grow(s->lval, c, sizeof *s->lval, &fail);
         if (fail)
-            return mps_err_set(err, MPS_ENOMEM, "pcg_ic0: cannot allocate the IC(0) factor "
-                                                "(%zu entries)", lnz);
+            return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate the IC(0) factor "
+                                                "(%zu entries)", method_names[s->method], lnz);
         s->cap_lnz = c;
     }
     s->lval[lptr[n]] = 0.0;
@@ -616,9 +733,9 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
     while ((row = ic0_factor(s, A, shift)) >= 0) {
         if (shift >= 10.0)
             return mps_err_set(err, MPS_ESOLVE,
-                               "pcg_ic0: incomplete Cholesky breaks down at row %d even with "
+                               "%s: incomplete Cholesky breaks down at row %d even with "
                                "the diagonal scaled by 1 + %g: matrix is not positive definite",
-                               row, shift);
+                               method_names[s->method], row, shift);
         shift = shift > 0.0 ? 10.0 * shift : 1e-3;
     }
     return MPS_OK;
@@ -656,7 +773,7 @@ static double ic0_apply(struct fluid_linsolve *s, int n, const double *r, double
 
 static double precond(struct fluid_linsolve *s, int n, const double *r, double *z)
 {
-    return s->method == M_PCG_IC0 ? ic0_apply(s, n, r, z) : k_jacobi(s, n, r, z);
+    return uses_ic0(s) ? ic0_apply(s, n, r, z) : k_jacobi(s, n, r, z);
 }
 
 static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, const double *b,
@@ -695,7 +812,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         s->diag[i] = k;
         s->dinv[i] = 1.0 / A->val[k];
     }
-    if (s->method == M_PCG_IC0 && (rc = ic0_setup(s, A, err)))
+    if (uses_ic0(s) && (rc = ic0_setup(s, A, err)))
         return rc;
     double t2 = omp_get_wtime();
     st->t_factor = t2 - t1;
@@ -936,7 +1053,7 @@ enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct flui
     memset(st, 0, sizeof *st);
     if (!s || !A || (A->n > 0 && !x))
         return mps_err_set(err, MPS_EINPUT, "fluid_linsolve_solve: NULL solver, matrix or x");
-    int iterative = s->method == M_PCG_JACOBI || s->method == M_PCG_IC0;
+    int iterative = s->method == M_PCG_JACOBI || uses_ic0(s);
     enum mps_status rc = check_input(s, A, b, iterative ? x : NULL, err);
     if (rc || A->n == 0)
         return rc;

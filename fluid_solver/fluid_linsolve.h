@@ -30,7 +30,8 @@ struct fluid_linsolve_stats {
 
 struct fluid_linsolve;
 
-/* method: "pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse" (keeps the
+/* method: "pcg_jacobi", "pcg_ic0", "pcg_sic0" (IC(0) of a sparsified
+ * matrix, see fluid_linsolve_set_drop), "cholmod", "cholmod_reuse" (keeps the
  * fill-reducing ordering while the matrix size and pattern allow), "auto"
  * (the measured default). rtol: relative residual for iterative methods.
  * max_iter: iteration cap (an iterative solve that hits it fails with
@@ -38,6 +39,15 @@ struct fluid_linsolve;
 enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *method,
                                       double rtol, int max_iter, int nthreads,
                                       struct mps_err *err);
+
+/* pcg_sic0's drop threshold theta in [0, 1): the preconditioner is IC(0) of
+ * the matrix without the couplings a_ij^2 < theta^2 a_ii a_jj, each dropped
+ * one added to the diagonal of its row (row sums kept). 0 drops nothing
+ * (pcg_ic0's preconditioner). Takes effect from the next solve. Other
+ * methods accept it and ignore it, so a case setting can be passed whatever
+ * the method. Fails with MPS_EINPUT outside [0, 1). */
+enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
+                                        struct mps_err *err);
 
 /* Solves A x = b. On entry x holds the initial guess (iterative methods start
  * from it: warm start from the previous step's pressure); on exit the

@@ -54,6 +54,7 @@ struct fluid_params {
     const char *ppe_solver;
     double ppe_rtol;
     int ppe_max_iter;
+    double ppe_drop;       /* pcg_sic0 drop threshold */
     double tank_w, tank_h;
     int tank_lid;
     int wall_layers;              /* wall + dummy layers, >= 3 */

@@ -111,7 +111,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %zu pairs", npairs);
     int *rowptr = f->rowptr;
     rowptr[0] = 0;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++)
         if (f->row[i] >= 0)
             rowptr[f->row[i] + 1] = row_weights(f, i, c, &f->rhs[f->row[i]]) + 1;
@@ -126,7 +126,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     /* pass 2: values. Neighbour lists are sorted by particle index and rows
      * follow particle order, so columns come out sorted; the diagonal is
      * inserted in its place. */
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++) {
         int r = f->row[i];
         if (r < 0)

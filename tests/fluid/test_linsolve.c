@@ -9,8 +9,9 @@
 #include "fluid_linsolve.h"
 #include "../test_util.h"
 
-static const char *const methods[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse", "auto"};
-#define NMETHODS 5
+static const char *const methods[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse", "auto",
+                                      "pcg_sic0"};
+#define NMETHODS 6
 
 struct mat {
     int n, *rowptr, *col;
@@ -271,8 +272,9 @@ static void scramble(struct mat *m)
 }
 
 /* 1 and 2 threads give the same answer; > 4096 rows, so the kernels run in
- * parallel and pcg_ic0 factorises 2 blocks (natural numbering) or falls back
- * to one (scrambled numbering, the split would drop half the couplings). */
+ * parallel and pcg_ic0 and pcg_sic0 factorise 2 blocks (natural numbering) or
+ * fall back to one (scrambled numbering, the split would drop half the
+ * couplings). */
 static void test_thread_counts_agree(void)
 {
     for (int scr = 0; scr < 2; scr++) {
@@ -281,7 +283,9 @@ static void test_thread_counts_agree(void)
         if (scr)
             scramble(&m);
         double *b = make_rhs(&m, 81);
-        for (int k = 0; k < 2; k++) {
+        const int pcgs[] = {0, 1, 5};   /* pcg_jacobi, pcg_ic0, pcg_sic0 */
+        for (int kk = 0; kk < 3; kk++) {
+            int k = pcgs[kk];
             double *x[2];
             int its[2];
             for (int t = 0; t < 2; t++) {
@@ -364,6 +368,100 @@ static void test_cholmod_reuse_across_matrices(void)
     mat_free(&m1b);
     mat_free(&m2);
     mat_free(&m3);
+}
+
+/* Solves with a new solver, drop threshold theta (< 0: the method's default). */
+static double *solve_drop(const char *method, double theta, const struct mat *m, const double *b,
+                          double rtol, int nthreads, struct fluid_linsolve_stats *st)
+{
+    struct fluid_linsolve *s = NULL;
+    struct mps_err err = {0};
+    double *x = calloc((size_t)m->n, sizeof *x);
+    CHECK(fluid_linsolve_create(&s, method, rtol, 10000, nthreads, &err) == MPS_OK);
+    if (theta >= 0.0)
+        CHECK(fluid_linsolve_set_drop(s, theta, &err) == MPS_OK);
+    enum mps_status rc = fluid_linsolve_solve(s, &m->csr, b, x, st, &err);
+    if (rc)
+        fprintf(stderr, "%s, theta %g: %s\n", method, theta, err.msg);
+    CHECK(rc == MPS_OK);
+    fluid_linsolve_destroy(&s);
+    return x;
+}
+
+/* pcg_sic0: converges to rtol on the true residual for a range of drop
+ * thresholds; theta = 0 drops nothing and is pcg_ic0 exactly (same
+ * iterations, same bits), with one block and with two; a threshold that
+ * drops couplings changes the iterations; the setter checks its range. */
+static void test_sparsified_ic0(void)
+{
+    const double rtol = 1e-8;
+    for (int big = 0; big < 2; big++) {
+        /* big: > 4096 rows, so 2 threads factorise 2 blocks */
+        int nx = big ? 80 : 50, ny = big ? 81 : 50;
+        struct mat m;
+        build(&m, nx, ny, 0.1, 0.0, 1e-4);
+        double *b = make_rhs(&m, ny);
+        for (int t = 1; t <= 1 + big; t++) {
+            struct fluid_linsolve_stats st0, st;
+            double *x0 = solve_drop("pcg_ic0", -1.0, &m, b, rtol, t, &st0);
+            double *xz = solve_drop("pcg_sic0", 0.0, &m, b, rtol, t, &st);
+            printf("  n = %d, %d thread(s): pcg_ic0 %d iterations, pcg_sic0 theta 0 %d\n", m.n,
+                   t, st0.iterations, st.iterations);
+            CHECK(st.iterations == st0.iterations);
+            CHECK(!memcmp(xz, x0, (size_t)m.n * sizeof *x0));
+            free(xz);
+            const double thetas[] = {-1.0, 0.005, 0.01, 0.02, 0.03, 0.05};
+            for (int k = 0; k < 6; k++) {
+                double *x = solve_drop("pcg_sic0", thetas[k], &m, b, rtol, t, &st);
+                double res = relres(&m.csr, b, x);
+                char lab[16] = "default";
+                if (thetas[k] >= 0.0)
+                    snprintf(lab, sizeof lab, "%g", thetas[k]);
+                printf("    theta %-7s %4d iterations, residual %.2e\n", lab, st.iterations,
+                       res);
+                CHECK(res <= rtol);
+                CHECK_NEAR(st.residual, res, 1e-3 * rtol);
+                CHECK(reldiff(m.n, x, x0) < 1e-5);
+                if (thetas[k] >= 0.01)   /* couplings dropped: another preconditioner */
+                    CHECK(st.iterations != st0.iterations);
+                free(x);
+            }
+            free(x0);
+        }
+        free(b);
+        mat_free(&m);
+    }
+
+    struct fluid_linsolve *s = NULL;
+    struct mps_err err = {0};
+    CHECK(fluid_linsolve_create(&s, "pcg_sic0", 1e-8, 100, 0, &err) == MPS_OK);
+    CHECK(fluid_linsolve_set_drop(s, -0.1, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "theta") != NULL);
+    CHECK(fluid_linsolve_set_drop(s, 1.0, &err) == MPS_EINPUT);
+    CHECK(fluid_linsolve_set_drop(s, NAN, &err) == MPS_EINPUT);
+    CHECK(fluid_linsolve_set_drop(NULL, 0.1, &err) == MPS_EINPUT);
+    fluid_linsolve_destroy(&s);
+    /* other methods take it and ignore it */
+    CHECK(fluid_linsolve_create(&s, "pcg_ic0", 1e-8, 100, 0, &err) == MPS_OK);
+    CHECK(fluid_linsolve_set_drop(s, 0.05, &err) == MPS_OK);
+    fluid_linsolve_destroy(&s);
+
+    /* Kershaw's matrix: SPD, but IC(0) meets a negative pivot (-5 in the
+     * last row), and theta = 0.5 drops every coupling, which leaves row 2 a
+     * diagonal of 3 - 2 - 2 < 0: both need the shifted-IC fallback. */
+    int rp[] = {0, 3, 6, 9, 12}, cl[] = {0, 1, 3, 0, 1, 2, 1, 2, 3, 0, 2, 3};
+    double vl[] = {3, -2, 2, -2, 3, -2, -2, 3, -2, 2, -2, 3}, bk[] = {1, 2, 3, 4};
+    struct fluid_csr ker = {4, rp, cl, vl};
+    const double kth[] = {0.0, 0.5};
+    for (int k = 0; k < 2; k++) {
+        double xk[4] = {0};
+        struct fluid_linsolve_stats st;
+        CHECK(fluid_linsolve_create(&s, "pcg_sic0", 1e-10, 100, 1, &err) == MPS_OK);
+        CHECK(fluid_linsolve_set_drop(s, kth[k], &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &ker, bk, xk, &st, &err) == MPS_OK);
+        CHECK(relres(&ker, bk, xk) <= 1e-10);
+        fluid_linsolve_destroy(&s);
+    }
 }
 
 static void test_zero_rhs(void)
@@ -483,6 +581,7 @@ int main(void)
     test_all_methods_solve_and_agree();
     test_thread_counts_agree();
     test_cholmod_reuse_across_matrices();
+    test_sparsified_ic0();
     test_zero_rhs();
     test_errors();
     return test_summary("test_linsolve");
