@@ -12,6 +12,10 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.nu", MPS_KEY_DOUBLE, "1e-6", 0, 0, NOHI, NULL, "m^2/s", "kinematic viscosity"},
     {"fluid.courant", MPS_KEY_DOUBLE, "0.2", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "Courant number C of Eq. 52"},
+    {"fluid.droplet_neighbours", MPS_KEY_INT, "0", 0, 12, 0, NULL, "",
+     "particles with fewer neighbours within re_n than this (droplets: P = 0, ballistic) "
+     "do not set the Courant step (Eq. 52); they are held to move at most dp per step "
+     "instead (0: every particle sets it, the paper)"},
     {"fluid.dt_max", MPS_KEY_DOUBLE, "1e-3", 0, 0, POS, NULL, "s", "cap on the fluid step"},
     {"fluid.dt_min", MPS_KEY_DOUBLE, "1e-7", 0, 0, POS, NULL, "s",
      "smallest step the CFL condition may ask for before the run is declared diverged"},
@@ -115,6 +119,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->rho = mps_case_double(c, "fluid.rho");
     p->nu = mps_case_double(c, "fluid.nu");
     p->courant = mps_case_double(c, "fluid.courant");
+    p->droplet_neighbours = (int)mps_case_int(c, "fluid.droplet_neighbours");
     p->dt_max = mps_case_double(c, "fluid.dt_max");
     p->dt_min = mps_case_double(c, "fluid.dt_min");
     p->kappa = mps_case_double(c, "fluid.kappa");

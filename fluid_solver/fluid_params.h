@@ -37,6 +37,7 @@ struct fluid_params {
     double dp, end_time, g[MPS_DIM];
     double rho, nu;
     double courant, dt_max, dt_min;
+    int droplet_neighbours; /* fewer neighbours within re_n: outside Eq. 52 */
     int mixed_source;             /* add the velocity-divergence source term */
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */

@@ -200,6 +200,37 @@ static void test_wall_modes(void)
     }
 }
 
+/* Eq. 52 and fluid.droplet_neighbours: a fast particle sets the step unless
+ * it is a droplet (fewer than k neighbours within re_n at the last step);
+ * a droplet is still held to one spacing per step. */
+static void test_droplet_step(void)
+{
+    const char *sets[2][2] = {{"dp=0.02", "fluid.droplet_neighbours=0"},
+                              {"dp=0.02", "fluid.droplet_neighbours=3"}};
+    double dts[2] = {0, 0};
+    for (int m = 0; m < 2; m++) {
+        struct fluid *f = make("cases/dambreak/case.yml", sets[m], 2);
+        CHECK(f != NULL);
+        if (!f)
+            return;
+        CHECK(step(f, 1e-3) == MPS_OK);
+        size_t i = 0; /* made a fast droplet by hand */
+        f->v[i][0] = 40.0;
+        f->v[i][1] = 0.0;
+        f->ncount[i] = 2;
+        dts[m] = fluid_cfl_dt(f);
+        if (m == 1) { /* a droplet with 3 neighbours is not one */
+            f->ncount[i] = 3;
+            CHECK_NEAR(fluid_cfl_dt(f), f->prm.courant * f->prm.dp / 40.0, 1e-12);
+        }
+        fluid_destroy(&f);
+    }
+    printf("40 m/s droplet: step %.3g s counted (C dp/u), %.3g s exempt (dp/u)\n", dts[0],
+           dts[1]);
+    CHECK_NEAR(dts[0], 0.2 * 0.02 / 40.0, 1e-12);
+    CHECK_NEAR(dts[1], 0.02 / 40.0, 1e-12);
+}
+
 static void test_verlet_list(void)
 {
     const char *sets[] = {"dp=0.008"};
@@ -259,6 +290,7 @@ int main(void)
     test_dambreak_first_step();
     test_paper_walls();
     test_wall_modes();
+    test_droplet_step();
     test_verlet_list();
     return test_summary("test_fluid_step");
 }
