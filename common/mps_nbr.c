@@ -104,55 +104,50 @@ void mps_nbr_grid_free(struct mps_nbr_grid *g)
 }
 
 
-/* Upper bound on the candidates of i: the particles of its 3^d cells. */
-static size_t candidates(const struct mps_nbr_grid *g, size_t i)
+/* The block of cells around particle i's cell that a query visits: columns
+ * a0..a1 of rows b0..b1, clipped to the grid. */
+struct cell_window {
+    int a0, a1, b0, b1;
+};
+
+static struct cell_window cell_window(const struct mps_nbr_grid *g, size_t i)
 {
-    size_t c = g->cell_of[i];
-    int ci[MPS_DIM];
-    for (int d = 0; d < MPS_DIM; d++) {
-        ci[d] = (int)(c % (size_t)g->dims[d]);
-        c /= (size_t)g->dims[d];
-    }
-    size_t m = 0;
-#if MPS_DIM == 2
-    int a0 = ci[0] > 0 ? ci[0] - 1 : 0;
-    int a1 = ci[0] + 1 < g->dims[0] ? ci[0] + 1 : g->dims[0] - 1;
-    for (int b = ci[1] - 1; b <= ci[1] + 1; b++) {
-        if (b < 0 || b >= g->dims[1])
-            continue;
-        size_t row = (size_t)b * (size_t)g->dims[0];
-        m += g->cell_start[row + (size_t)a1 + 1] - g->cell_start[row + (size_t)a0];
-    }
-#else
+#if MPS_DIM != 2
 #error "mps_nbr: only MPS_DIM == 2 is implemented"
 #endif
+    size_t c = g->cell_of[i];
+    int cx = (int)(c % (size_t)g->dims[0]), cy = (int)(c / (size_t)g->dims[0]);
+    struct cell_window w = {cx > 0 ? cx - 1 : 0, cx + 1 < g->dims[0] ? cx + 1 : g->dims[0] - 1,
+                            cy > 0 ? cy - 1 : 0, cy + 1 < g->dims[1] ? cy + 1 : g->dims[1] - 1};
+    return w;
+}
+
+/* Upper bound on the candidates in a window: the particles of its cells
+ * (each row of cells is a contiguous stretch of sorted[]). */
+static size_t candidates(const struct mps_nbr_grid *g, const struct cell_window *w)
+{
+    size_t m = 0;
+    for (int b = w->b0; b <= w->b1; b++) {
+        size_t row = (size_t)b * (size_t)g->dims[0];
+        m += g->cell_start[row + (size_t)w->a1 + 1] - g->cell_start[row + (size_t)w->a0];
+    }
     return m;
 }
 
-/* Writes the neighbours of i into jout/r2out (room for candidates(g, i))
- * sorted by j and returns their number. Each row of cells is a contiguous
- * stretch of sorted[], in index order within a cell; tmp (same room) holds
- * the runs before they are merged. */
+/* Writes the neighbours of i found in window w into jout/r2out (room for
+ * candidates(g, w)) sorted by j and returns their number. Within a cell
+ * particles are in index order; tmp (same room) holds these runs before
+ * they are merged. */
 static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], size_t i,
-                    double r2max, int *jout, double *r2out, int *jtmp, double *r2tmp)
+                    const struct cell_window *w, double r2max, int *jout, double *r2out,
+                    int *jtmp, double *r2tmp)
 {
-    size_t c = g->cell_of[i];
-    int ci[MPS_DIM];
-    for (int d = 0; d < MPS_DIM; d++) {
-        ci[d] = (int)(c % (size_t)g->dims[d]);
-        c /= (size_t)g->dims[d];
-    }
     const double xi = x[i][0], yi = x[i][1];
     size_t runs[3 * 3 + 1], nruns = 0, m = 0;
     runs[0] = 0;
-#if MPS_DIM == 2
-    int a0 = ci[0] > 0 ? ci[0] - 1 : 0;
-    int a1 = ci[0] + 1 < g->dims[0] ? ci[0] + 1 : g->dims[0] - 1;
-    for (int b = ci[1] - 1; b <= ci[1] + 1; b++) {
-        if (b < 0 || b >= g->dims[1])
-            continue;
+    for (int b = w->b0; b <= w->b1; b++) {
         size_t row = (size_t)b * (size_t)g->dims[0];
-        for (int a = a0; a <= a1; a++) {
+        for (int a = w->a0; a <= w->a1; a++) {
             /* one run per cell: sorted by index within the cell */
             for (size_t k = g->cell_start[row + (size_t)a]; k < g->cell_start[row + (size_t)a + 1];
                  k++) {
@@ -168,34 +163,33 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
                 runs[++nruns] = m;
         }
     }
-#endif
     /* merge the runs pairwise until one is left, ping-ponging between the
      * two buffers (at most 9 runs: 4 rounds) */
     int *js = jtmp, *jd = jout;
     double *rs = r2tmp, *rd = r2out;
     while (nruns > 1) {
-        size_t w = 0, nr = 0;
+        size_t o = 0, nr = 0;
         for (size_t q = 0; q < nruns; q += 2) {
             size_t p1 = runs[q], e1 = runs[q + 1];
             size_t p2 = q + 1 < nruns ? runs[q + 1] : e1, e2 = q + 1 < nruns ? runs[q + 2] : e1;
             while (p1 < e1 && p2 < e2) {
                 if (js[p1] < js[p2]) {
-                    jd[w] = js[p1];
-                    rd[w++] = rs[p1++];
+                    jd[o] = js[p1];
+                    rd[o++] = rs[p1++];
                 } else {
-                    jd[w] = js[p2];
-                    rd[w++] = rs[p2++];
+                    jd[o] = js[p2];
+                    rd[o++] = rs[p2++];
                 }
             }
-            for (; p1 < e1; p1++, w++) {
-                jd[w] = js[p1];
-                rd[w] = rs[p1];
+            for (; p1 < e1; p1++, o++) {
+                jd[o] = js[p1];
+                rd[o] = rs[p1];
             }
-            for (; p2 < e2; p2++, w++) {
-                jd[w] = js[p2];
-                rd[w] = rs[p2];
+            for (; p2 < e2; p2++, o++) {
+                jd[o] = js[p2];
+                rd[o] = rs[p2];
             }
-            runs[++nr] = w;
+            runs[++nr] = o;
         }
         nruns = nr;
         int *tj = js;
@@ -269,7 +263,8 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
         for (size_t i = lo; i < hi; i++) {
             size_t m = 0;
             if (!query || query[i]) {
-                size_t room = candidates(g, i);
+                struct cell_window w = cell_window(g, i);
+                size_t room = candidates(g, &w);
                 if (grow((void **)&jb, &cap, used + room + 1, sizeof *jb) ||
                     grow((void **)&rb, &cap2, used + room + 1, sizeof *rb) ||
                     grow((void **)&jt, &capt, room + 1, sizeof *jt) ||
@@ -277,7 +272,7 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
                     lfail = 1;
                     break;
                 }
-                m = visit(g, x, i, r2max, jb + used, rb + used, jt, rt);
+                m = visit(g, x, i, &w, r2max, jb + used, rb + used, jt, rt);
             }
             l->start[i + 1] = m;
             used += m;

@@ -600,7 +600,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     collide(f, dt);
 
     /* Eq. 8 at x*, and the free-surface double check (paper 4.3), for the
-     * PPE unknowns: fluid (Neumann walls), or fluid, wall and solid surface */
+     * PPE unknowns (f->unknown: which they are depends on fluid.wall_bc) */
     mps_timer_switch(&f->timer, PH_DENSITY);
     const int ghosts = p->wall_bc != FLUID_WALL_PPE;
     const unsigned char *rows = f->unknown;

@@ -4,12 +4,12 @@
  *   [nfluid, nfixed_end)   tank wall (first layer) and dummy layers
  *   [nfixed_end, n)        solid particles given by a coupled solid (moving
  *                          boundary), surface and inner ones.
- * Boundary pressure (fluid.wall_bc): with Neumann walls (default) only fluid
- * particles are PPE unknowns and every boundary particle takes the fluid's
- * pressure extrapolated hydrostatically; with the paper's walls the wall
- * and solid surface particles are PPE unknowns and dummies carry none;
- * solid_ppe puts the solid surface in the PPE (the paper's coupling) and
- * keeps Neumann tank walls. fluid_update_masks() says who is what.
+ * Boundary pressure (fluid.wall_bc): with Neumann walls only fluid particles
+ * are PPE unknowns and every boundary particle takes the fluid's pressure
+ * extrapolated hydrostatically; with the paper's walls the wall and solid
+ * surface particles are PPE unknowns and dummies carry none; solid_ppe (the
+ * default) puts the solid surface in the PPE (the paper's coupling) and keeps
+ * Neumann tank walls. fluid_update_masks() says who is what.
  * docs/fluid.md describes the step and every deviation from the paper. */
 #ifndef FLUID_H
 #define FLUID_H

@@ -165,7 +165,7 @@ static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struc
         s->mark = grow(s->mark, c, sizeof *s->mark, &fail);
         s->linv = grow(s->linv, c, sizeof *s->linv, &fail);
     }
-    if (s->method == M_PCG_SIC0)
+    if (uses_ic0(s))
         s->comp = grow(s->comp, c, sizeof *s->comp, &fail);
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate work vectors for %zu rows",
@@ -572,40 +572,26 @@ static int ic0_factor_block(struct fluid_linsolve *s, const struct fluid_csr *A,
     int *lptr = s->lptr, *lcol = s->lcol, *mark = s->mark;
     double *lval = s->lval, *linv = s->linv;
     const int zero = lptr[A->n];
-    if (s->method == M_PCG_SIC0) {
-        /* The block's lower triangle of A~ (see sic0_weak), the dropped
-         * couplings (s->comp, from ic0_setup) added to the diagonal. Every
-         * entry is written and the position advances only for kept ones:
-         * no branch on a test that is true about as often as false. nz never
-         * passes the diagonal's slot, which is written last. The shift scales
-         * a_ii, not a~_ii, so that the fallback still reaches positive
-         * pivots if the compensation left a~_ii small; with nothing dropped
-         * this is pcg_ic0's diagonal bit for bit. */
-        for (int i = lo; i < hi; i++) {
-            int nz = lptr[i], k = A->rowptr[i];
-            while (A->col[k] < lo)
-                k++;
-            for (; k < s->diag[i]; k++) {
-                lcol[nz] = A->col[k];
-                lval[nz] = A->val[k];
-                nz += !sic0_weak(s, i, A->col[k], A->val[k]);
-            }
-            lcol[nz] = i;
-            lval[nz] = A->val[s->diag[i]] * (1.0 + shift) + s->comp[i];
-            mark[i] = zero;
+    /* The block's lower triangle of A~ (see sic0_weak), the dropped
+     * couplings (s->comp, from ic0_setup) added to the diagonal. Every
+     * entry is written and the position advances only for kept ones:
+     * no branch on a test that is true about as often as false. nz never
+     * passes the diagonal's slot, which is written last. The shift scales
+     * a_ii, not a~_ii, so that the fallback still reaches positive
+     * pivots if the compensation left a~_ii small. pcg_ic0 is this with
+     * drop2 = 0: nothing is dropped, comp is 0, the factor is IC(0) of A. */
+    for (int i = lo; i < hi; i++) {
+        int nz = lptr[i], k = A->rowptr[i];
+        while (A->col[k] < lo)
+            k++;
+        for (; k < s->diag[i]; k++) {
+            lcol[nz] = A->col[k];
+            lval[nz] = A->val[k];
+            nz += !sic0_weak(s, i, A->col[k], A->val[k]);
         }
-    } else {
-        for (int i = lo; i < hi; i++) {   /* copy the block's lower triangle */
-            int nz = lptr[i], k = A->rowptr[i];
-            while (A->col[k] < lo)
-                k++;
-            for (; k <= s->diag[i]; k++) {
-                lcol[nz] = A->col[k];
-                lval[nz++] = A->val[k];
-            }
-            lval[nz - 1] *= 1.0 + shift;
-            mark[i] = zero;
-        }
+        lcol[nz] = i;
+        lval[nz] = A->val[s->diag[i]] * (1.0 + shift) + s->comp[i];
+        mark[i] = zero;
     }
     for (int i = lo; i < hi; i++) {
         int rlo = lptr[i], dpos = lptr[i + 1] - 1;
@@ -661,45 +647,34 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
     reduction(+ : dropped, kept)
         for (int b = 0; b < nblk; b++) {
             int lo = blk_lo(n, nblk, b), hi = blk_lo(n, nblk, b + 1);
-            if (s->method == M_PCG_SIC0) {
-                /* Only the couplings A~ keeps count, for the length and the
-                 * split. The weak ones of each row go to s->comp, read from
-                 * the lower triangle only (half the traffic of whole rows):
-                 * a weak a_ij, j < i, counts for row i and, in the same
-                 * block, for row j; row i's weak couplings to later blocks
-                 * are read from the end of its row. Branch-free where the
-                 * test is as often true as false, see ic0_factor_block. */
-                double *comp = s->comp;
-                for (int i = lo; i < hi; i++)
-                    comp[i] = 0.0;
-                for (int i = lo; i < hi; i++) {
-                    int len = 1, out = 0;
-                    double ci = 0.0;
-                    for (int k = A->rowptr[i]; k < s->diag[i]; k++) {
-                        int j = A->col[k], strong = !sic0_weak(s, i, j, A->val[k]);
-                        double w = strong ? 0.0 : A->val[k];
-                        ci += w;
-                        if (j >= lo)
-                            comp[j] += w;
-                        len += strong & (j >= lo);
-                        out += strong & (j < lo);
-                    }
-                    for (int k = A->rowptr[i + 1] - 1; A->col[k] >= hi; k--)
-                        ci += sic0_weak(s, i, A->col[k], A->val[k]) ? A->val[k] : 0.0;
-                    comp[i] += ci;
-                    lptr[i + 1] = len;
-                    kept += len - 1;
-                    dropped += out;
-                }
-                continue;
-            }
+            /* Only the couplings A~ keeps count, for the length and the
+             * split. The weak ones of each row go to s->comp, read from
+             * the lower triangle only (half the traffic of whole rows):
+             * a weak a_ij, j < i, counts for row i and, in the same
+             * block, for row j; row i's weak couplings to later blocks
+             * are read from the end of its row. Branch-free where the
+             * test is as often true as false, see ic0_factor_block. */
+            double *comp = s->comp;
+            for (int i = lo; i < hi; i++)
+                comp[i] = 0.0;
             for (int i = lo; i < hi; i++) {
-                int k = A->rowptr[i];
-                while (A->col[k] < lo)
-                    k++;
-                lptr[i + 1] = s->diag[i] - k + 1;
-                dropped += k - A->rowptr[i];
-                kept += s->diag[i] - k;
+                int len = 1, out = 0;
+                double ci = 0.0;
+                for (int k = A->rowptr[i]; k < s->diag[i]; k++) {
+                    int j = A->col[k], strong = !sic0_weak(s, i, j, A->val[k]);
+                    double w = strong ? 0.0 : A->val[k];
+                    ci += w;
+                    if (j >= lo)
+                        comp[j] += w;
+                    len += strong & (j >= lo);
+                    out += strong & (j < lo);
+                }
+                for (int k = A->rowptr[i + 1] - 1; A->col[k] >= hi; k--)
+                    ci += sic0_weak(s, i, A->col[k], A->val[k]) ? A->val[k] : 0.0;
+                comp[i] += ci;
+                lptr[i + 1] = len;
+                kept += len - 1;
+                dropped += out;
             }
         }
         /* Measured (synthetic PPE, 20k rows, 2 blocks): iterations grow 1.3x
