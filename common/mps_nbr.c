@@ -213,6 +213,12 @@ enum mps_status mps_nbr_list_build(struct mps_nbr_list *l, const struct mps_nbr_
     return mps_nbr_list_build_masked(l, g, x, nquery, NULL, radius, err);
 }
 
+struct mps_nbr_scratch {
+    int *jb, *jt;          /* the thread's rows; one query's runs before the merge */
+    double *rb, *rt;
+    size_t cap, cap2, capt, capt2;
+};
+
 /* One pass: each thread visits a contiguous block of queries into its own
  * buffer, then copies it to its place once the row offsets are known. */
 enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
@@ -235,6 +241,14 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
      * fluid queries its first particles only, and an even split by index
      * gave one thread nearly all the work. */
     const int ntmax = omp_get_max_threads();
+    if (l->nscratch < ntmax) {
+        struct mps_nbr_scratch *sc = realloc(l->scratch, (size_t)ntmax * sizeof *sc);
+        if (!sc)
+            return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
+        memset(sc + l->nscratch, 0, (size_t)(ntmax - l->nscratch) * sizeof *sc);
+        l->scratch = sc;
+        l->nscratch = ntmax;
+    }
     size_t *bound = malloc(((size_t)ntmax + 1) * sizeof *bound);
     if (!bound)
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
@@ -256,23 +270,22 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
             lo = nquery * (size_t)t / (size_t)nt;
             hi = nquery * (size_t)(t + 1) / (size_t)nt;
         }
-        int *jb = NULL, *jt = NULL;
-        double *rb = NULL, *rt = NULL;
-        size_t cap = 0, capt = 0, capt2 = 0, cap2 = 0, used = 0;
+        struct mps_nbr_scratch *sc = &l->scratch[t];
+        size_t used = 0;
         int lfail = 0;
         for (size_t i = lo; i < hi; i++) {
             size_t m = 0;
             if (!query || query[i]) {
                 struct cell_window w = cell_window(g, i);
                 size_t room = candidates(g, &w);
-                if (grow((void **)&jb, &cap, used + room + 1, sizeof *jb) ||
-                    grow((void **)&rb, &cap2, used + room + 1, sizeof *rb) ||
-                    grow((void **)&jt, &capt, room + 1, sizeof *jt) ||
-                    grow((void **)&rt, &capt2, room + 1, sizeof *rt)) {
+                if (grow((void **)&sc->jb, &sc->cap, used + room + 1, sizeof *sc->jb) ||
+                    grow((void **)&sc->rb, &sc->cap2, used + room + 1, sizeof *sc->rb) ||
+                    grow((void **)&sc->jt, &sc->capt, room + 1, sizeof *sc->jt) ||
+                    grow((void **)&sc->rt, &sc->capt2, room + 1, sizeof *sc->rt)) {
                     lfail = 1;
                     break;
                 }
-                m = visit(g, x, i, &w, r2max, jb + used, rb + used, jt, rt);
+                m = visit(g, x, i, &w, r2max, sc->jb + used, sc->rb + used, sc->jt, sc->rt);
             }
             l->start[i + 1] = m;
             used += m;
@@ -295,13 +308,9 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
                 l->cap_pairs = c1 < c2 ? c1 : c2;
         }
         if (!fail && used > 0) {
-            memcpy(l->j + l->start[lo], jb, used * sizeof *jb);
-            memcpy(l->r2 + l->start[lo], rb, used * sizeof *rb);
+            memcpy(l->j + l->start[lo], sc->jb, used * sizeof *sc->jb);
+            memcpy(l->r2 + l->start[lo], sc->rb, used * sizeof *sc->rb);
         }
-        free(jb);
-        free(rb);
-        free(jt);
-        free(rt);
     }
     free(bound);
     if (fail)
@@ -310,7 +319,7 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
     return MPS_OK;
 }
 
-enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_list *src,
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err)
 {
@@ -331,6 +340,7 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_n
                 double dx = x[j][d] - x[i][d];
                 r2 += dx * dx;
             }
+            src->r2[k] = r2;
             m += r2 < r2max;
         }
         dst->start[i + 1] = m;
@@ -346,14 +356,9 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_n
     for (size_t i = 0; i < n; i++) {
         size_t m = dst->start[i];
         for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            int j = src->j[k];
-            double r2 = 0.0;
-            for (int d = 0; d < MPS_DIM; d++) {
-                double dx = x[j][d] - x[i][d];
-                r2 += dx * dx;
-            }
+            double r2 = src->r2[k];
             if (r2 < r2max) {
-                dst->j[m] = j;
+                dst->j[m] = src->j[k];
                 dst->r2[m++] = r2;
             }
         }
@@ -406,6 +411,13 @@ void mps_nbr_list_free(struct mps_nbr_list *l)
     free(l->start);
     free(l->j);
     free(l->r2);
+    for (int t = 0; t < l->nscratch; t++) {
+        free(l->scratch[t].jb);
+        free(l->scratch[t].rb);
+        free(l->scratch[t].jt);
+        free(l->scratch[t].rt);
+    }
+    free(l->scratch);
     memset(l, 0, sizeof *l);
 }
 

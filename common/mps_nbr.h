@@ -31,6 +31,9 @@ struct mps_nbr_list {
     double *r2;           /* squared distance */
     size_t cap_n, cap_pairs;
     double radius;
+    /* per-thread buffers of the build, kept so a rebuild allocates nothing */
+    struct mps_nbr_scratch *scratch;
+    int nscratch;
 };
 
 /* Bins n particles into cells of width cell. Positions must be finite: a NaN
@@ -63,8 +66,10 @@ void mps_nbr_list_free(struct mps_nbr_list *l);
 
 /* The pairs of src that are closer than radius at positions x (which may have
  * moved since src was built: r2 is recomputed), kept in src's order. Used to
- * derive a short-radius list from a long-radius list with a skin. */
-enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+ * derive a short-radius list from a long-radius list with a skin. src->r2 is
+ * overwritten with the squared distances at x (the second pass reads them
+ * instead of gathering x[j] again). */
+enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_list *src,
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err);
 

@@ -257,8 +257,10 @@ static enum mps_status update_neighbours(struct fluid *f, int reorder, struct mp
     int stale = f->nl.n != n || f->step == 0;
     if (!stale) {
         double m2 = 0.0;
+        /* the tank [nfluid, nfixed_end) does not move */
 #pragma omp parallel for schedule(static) reduction(max : m2)
-        for (size_t i = 0; i < n; i++) {
+        for (size_t q = 0; q < n - (f->nfixed_end - f->nfluid); q++) {
+            size_t i = q < f->nfluid ? q : q - f->nfluid + f->nfixed_end;
             double d2 = 0.0;
             for (int d = 0; d < MPS_DIM; d++) {
                 double dx = f->x[i][d] - f->xref[i][d];
