@@ -58,6 +58,7 @@ struct coupler {
     struct peer p[NPEERS];
     void *zctx;
     char rundir[256];
+    char cpu_note[160];    /* what coupling.pin_cpus did, for the summary */
     int quiet;
     double hello_timeout, ready_timeout, step_timeout;
     /* the solid's interface, held between steps (owned decoded message) */
@@ -512,6 +513,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_num(&j, "coupler_other", wall - solvers - msg);
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
+    mps_json_str(&j, "cpu_placement", c->cpu_note);
     mps_json_object(&j, "solvers");
     for (int k = 0; k < NPEERS; k++) {
         struct peer *p = &c->p[k];
@@ -674,6 +676,9 @@ int main(int argc, char **argv)
                          strerror(errno));
         goto end;
     }
+    /* before the first socket: ZeroMQ's I/O threads inherit the placement */
+    launch_share_cpu(strcmp(mps_case_string(c.cs, "coupling.pin_cpus"), "auto") == 0,
+                     c.cpu_note, sizeof c.cpu_note);
     c.zctx = zmq_ctx_new();
     if (!c.zctx) {
         st = mps_err_set(&err, MPS_ELIB, "zmq_ctx_new: %s", zmq_strerror(zmq_errno()));

@@ -1,8 +1,10 @@
+#define _GNU_SOURCE /* sched_setaffinity, CPU_SET */
 #include "launch.h"
 
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -61,6 +63,61 @@ static void resolve(const char *word, char *out, size_t len)
         memcpy(out, cand, strlen(cand) + 1);
 }
 
+/* Set by launch_share_cpu: the mask the solvers get back, and their places. */
+static struct {
+    int on;
+    cpu_set_t allowed;
+    char places[8192];
+} shared;
+
+int launch_share_cpu(int want, char *note, size_t len)
+{
+    if (!want) {
+        snprintf(note, len, "off (coupling.pin_cpus)");
+        return 0;
+    }
+    if (getenv("OMP_PLACES") || getenv("OMP_PROC_BIND")) {
+        snprintf(note, len, "off: OMP_PLACES or OMP_PROC_BIND set by the user");
+        return 0;
+    }
+    cpu_set_t a;
+    CPU_ZERO(&a);
+    if (sched_getaffinity(0, sizeof a, &a) != 0) {
+        snprintf(note, len, "off: sched_getaffinity: %s", strerror(errno));
+        return 0;
+    }
+    if (CPU_COUNT(&a) < 2) {
+        snprintf(note, len, "off: one CPU");
+        return 0;
+    }
+    int first = -1;
+    size_t used = 0;
+    for (int cpu = 0; cpu < CPU_SETSIZE; cpu++) {
+        if (!CPU_ISSET(cpu, &a))
+            continue;
+        if (first < 0)
+            first = cpu;
+        int w = snprintf(shared.places + used, sizeof shared.places - used, "%s{%d}",
+                         used ? "," : "", cpu);
+        if (w < 0 || (size_t)w >= sizeof shared.places - used) {
+            snprintf(note, len, "off: too many CPUs to list in OMP_PLACES");
+            return 0;
+        }
+        used += (size_t)w;
+    }
+    cpu_set_t one;
+    CPU_ZERO(&one);
+    CPU_SET(first, &one);
+    if (sched_setaffinity(0, sizeof one, &one) != 0) {
+        snprintf(note, len, "off: sched_setaffinity: %s", strerror(errno));
+        return 0;
+    }
+    shared.on = 1;
+    shared.allowed = a;
+    snprintf(note, len, "CPU %d shared by the coupler and the solvers' main threads", first);
+    return 1;
+}
+
 enum mps_status launch_start(struct child *c, const char *name, const char *command,
                              const char *endpoint, struct mps_err *err)
 {
@@ -103,6 +160,13 @@ enum mps_status launch_start(struct child *c, const char *name, const char *comm
         if (!getenv("OMP_WAIT_POLICY")) {
             setenv("GOMP_SPINCOUNT", "20000", 0);
             setenv("KMP_BLOCKTIME", "1", 0);
+        }
+        if (shared.on) {
+            /* back to every CPU; OpenMP puts the main thread on the shared
+             * one (the first place) and the workers on the others */
+            sched_setaffinity(0, sizeof shared.allowed, &shared.allowed);
+            setenv("OMP_PLACES", shared.places, 0);
+            setenv("OMP_PROC_BIND", "close", 0);
         }
         execvp(words[0], words);
         fprintf(stderr, "coupler: cannot start the %s solver '%s': %s\n", name, words[0],

@@ -17,6 +17,19 @@ struct child {
     int status;            /* waitpid status once exited */
 };
 
+/* Message latency between processes depends on where they run: on this
+ * 2-core VM a ZeroMQ round trip between two processes on different CPUs
+ * takes 94 us (each hop wakes a thread on the other CPU), on one CPU 17 us
+ * (bench/zmq_roundtrip.c). The processes take turns, so they can share one:
+ * with want set, this pins the calling process (the coupler, before it opens
+ * any socket) to its first allowed CPU, and solvers launched afterwards get
+ * every allowed CPU back with OMP_PLACES listing that CPU first and
+ * OMP_PROC_BIND=close, so OpenMP binds their main thread to it and their
+ * workers to the others. Does nothing with one CPU, or if the user set
+ * OMP_PLACES or OMP_PROC_BIND. Returns 1 if pinned; note says what was done
+ * and why. */
+int launch_share_cpu(int want, char *note, size_t len);
+
 /* Launches `command --connect endpoint [--timeout S]`. */
 enum mps_status launch_start(struct child *c, const char *name, const char *command,
                              const char *endpoint, struct mps_err *err);

@@ -177,6 +177,72 @@ def t_wrong_version():
     check(told.startswith('REJECT') and 'version 2' in told, f'solver was told: {told.strip()}')
 
 
+def cpus_allowed(pid, tid=None):
+    """The CPUs a thread may run on, from /proc."""
+    path = f'/proc/{pid}/task/{tid or pid}/status'
+    with open(path) as f:
+        line = next(l for l in f if l.startswith('Cpus_allowed_list:'))
+    cpus = set()
+    for part in line.split(':', 1)[1].strip().split(','):
+        lo, _, hi = part.partition('-')
+        cpus.update(range(int(lo), int(hi or lo) + 1))
+    return cpus
+
+
+def placement_while_running(extra):
+    """Starts a long coupled run, and once it steps reads where the coupler
+    and the fluid's threads may run; then stops it with SIGTERM."""
+    out = tempfile.mkdtemp(prefix='cpl_cpu_')
+    env = {k: v for k, v in os.environ.items() if k not in ('OMP_PLACES', 'OMP_PROC_BIND')}
+    env['OMP_NUM_THREADS'] = '2'
+    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                          '--set', 'end_time=20'] + extra, stderr=subprocess.PIPE, text=True,
+                         env=env)
+    for _ in range(300):
+        time.sleep(0.1)
+        if os.path.exists(os.path.join(out, 'probes.csv')) and len(probes(out)) > 3:
+            break
+    fluid = None
+    for k in subprocess.run(['pgrep', '-P', str(p.pid)], capture_output=True,
+                            text=True).stdout.split():
+        with open(f'/proc/{k}/cmdline', 'rb') as f:
+            if b'fluid_solver' in f.read():
+                fluid = int(k)
+    seen = {'coupler': cpus_allowed(p.pid)}
+    if fluid:
+        seen['fluid_main'] = cpus_allowed(fluid)
+        seen['fluid_others'] = [cpus_allowed(fluid, int(t)) for t in os.listdir(f'/proc/{fluid}/task')
+                                if int(t) != fluid]
+    p.send_signal(signal.SIGTERM)
+    p.communicate(timeout=60)
+    s = json.load(open(os.path.join(out, 'summary.json')))
+    return seen, s.get('cpu_placement', '')
+
+
+def t_cpu_placement():
+    """coupling.pin_cpus: auto puts the coupler and the fluid's main thread on
+    one CPU (messages then cost a context switch, not a wake-up on another
+    CPU: bench/zmq_roundtrip.c) and leaves the fluid's other threads (OpenMP
+    workers, ZeroMQ's) free to use every CPU or bound elsewhere; off leaves
+    everything on every CPU."""
+    allowed = os.sched_getaffinity(0)
+    if len(allowed) < 2:
+        print('one CPU: nothing to place')
+        return
+    seen, note = placement_while_running([])
+    check(len(seen['coupler']) == 1, f'auto: coupler on one CPU ({sorted(seen["coupler"])})')
+    check(seen.get('fluid_main') == seen['coupler'],
+          f'auto: fluid main thread on the same CPU ({sorted(seen.get("fluid_main", []))})')
+    others = seen.get('fluid_others', [])
+    check(any(o - seen['coupler'] for o in others),
+          f'auto: some fluid thread (an OpenMP worker) may run on another CPU ({[sorted(o) for o in others]})')
+    check('shared' in note, f'summary says what was done: {note!r}')
+    seen, note = placement_while_running(['--set', 'coupling.pin_cpus=off'])
+    check(seen['coupler'] == allowed and seen.get('fluid_main') == allowed,
+          f'off: coupler and fluid on every CPU ({sorted(seen["coupler"])}, {sorted(seen.get("fluid_main", []))})')
+    check(note.startswith('off'), f'summary says off: {note!r}')
+
+
 TESTS = {k[2:]: v for k, v in globals().items() if k.startswith('t_')}
 
 if __name__ == '__main__':

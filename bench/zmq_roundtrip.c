@@ -1,0 +1,84 @@
+/* The floor under the coupler's messaging: the round trip of one small
+ * message between two processes over ZeroMQ on this machine, with nothing
+ * else to do. A coupled step makes two such round trips (coupler-fluid,
+ * coupler-solid), so twice this is the least messaging a step can cost.
+ *
+ *   cc -O2 bench/zmq_roundtrip.c -o /tmp/zmq_roundtrip -lzmq
+ *   /tmp/zmq_roundtrip [ROUND_TRIPS] [BYTES] [ENDPOINT]
+ *
+ * defaults: 5000 round trips of 2000 bytes over ipc:///tmp/zmq_roundtrip.sock.
+ * The receiver blocks in zmq_poll as the solvers do. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <sys/wait.h>
+#include <time.h>
+#include <unistd.h>
+#include <zmq.h>
+
+static double now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+/* Waits up to 5 s for one message; returns 0 on success. */
+static int recv_one(void *s, char *buf, size_t size)
+{
+    zmq_pollitem_t item = {s, 0, ZMQ_POLLIN, 0};
+    if (zmq_poll(&item, 1, 5000) != 1)
+        return -1;
+    return zmq_recv(s, buf, size, 0) < 0 ? -1 : 0;
+}
+
+int main(int argc, char **argv)
+{
+    int n = argc > 1 ? atoi(argv[1]) : 5000;
+    size_t size = argc > 2 ? (size_t)atol(argv[2]) : 2000;
+    const char *endpoint = argc > 3 ? argv[3] : "ipc:///tmp/zmq_roundtrip.sock";
+    if (n < 2 || size == 0) {
+        fprintf(stderr, "usage: %s [ROUND_TRIPS >= 2] [BYTES > 0] [ENDPOINT]\n", argv[0]);
+        return 2;
+    }
+    char *buf = calloc(size, 1);
+    if (!buf)
+        return 1;
+    pid_t pid = fork();
+    if (pid < 0) {
+        perror("fork");
+        return 1;
+    }
+    void *ctx = zmq_ctx_new();
+    void *s = zmq_socket(ctx, ZMQ_PAIR);
+    int linger = 0;
+    zmq_setsockopt(s, ZMQ_LINGER, &linger, sizeof linger);
+    if (pid == 0) { /* echo */
+        if (zmq_connect(s, endpoint) != 0)
+            return 1;
+        for (int i = 0; i < n; i++)
+            if (recv_one(s, buf, size) || zmq_send(s, buf, size, 0) < 0)
+                return 1;
+    } else {
+        if (zmq_bind(s, endpoint) != 0) {
+            fprintf(stderr, "cannot bind %s: %s\n", endpoint, zmq_strerror(zmq_errno()));
+            return 1;
+        }
+        double t0 = 0.0;
+        for (int i = 0; i < n; i++) {
+            if (i == 1)
+                t0 = now(); /* the first trip includes the connection */
+            if (zmq_send(s, buf, size, 0) < 0 || recv_one(s, buf, size)) {
+                fprintf(stderr, "round trip %d failed\n", i);
+                return 1;
+            }
+        }
+        printf("%d round trips of %zu bytes over %s: %.1f us each\n", n - 1, size, endpoint,
+               1e6 * (now() - t0) / (n - 1));
+        int status = 0;
+        waitpid(pid, &status, 0);
+    }
+    zmq_close(s);
+    zmq_ctx_term(ctx);
+    free(buf);
+    return 0;
+}
