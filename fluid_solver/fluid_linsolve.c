@@ -43,8 +43,13 @@ static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "
  * spacings. See docs/ppe_solvers.md. */
 #define SIC0_DEFAULT_DROP 0.015
 
-/* Below this many rows a parallel region costs more than it saves. */
-#define PAR_MIN_ROWS 4096
+/* Below this many rows a parallel region costs more than it saves. With
+ * threads that spin between regions (the coupler sets GOMP_SPINCOUNT) a
+ * region costs a few microseconds: at 1,100 rows (plate, 6 mm) two threads
+ * already solve 7% faster than one, at 4,300 rows (3 mm) 12% (the blocks of
+ * the IC(0) factor add about one iteration in 15). It was 4096, set when
+ * the threads slept between regions. */
+#define PAR_MIN_ROWS 512
 /* Per-thread partial sums, padded to a cache line so threads do not share one. */
 #define PAD 8
 
