@@ -370,39 +370,68 @@ enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_
                                      size_t from_lo, size_t from_hi, size_t to_lo, size_t to_hi,
                                      struct mps_err *err)
 {
-    const size_t n = src->n;
+    const size_t n = src->n, m = to_hi > to_lo ? to_hi - to_lo : 0;
     if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
     dst->n = n;
     dst->radius = src->radius;
-    memset(dst->start, 0, (n + 1) * sizeof *dst->start);
-    for (size_t i = from_lo; i < from_hi; i++)
-        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            size_t j = (size_t)src->j[k];
-            if (j >= to_lo && j < to_hi)
-                dst->start[j + 1]++;
-        }
-    for (size_t i = 0; i < n; i++)
-        dst->start[i + 1] += dst->start[i];
-    size_t npairs = dst->start[n], cap = dst->cap_pairs, cap2 = dst->cap_pairs;
-    if (grow((void **)&dst->j, &cap, npairs + 1, sizeof(int)) ||
-        grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
-        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
-    dst->cap_pairs = cap < cap2 ? cap : cap2;
-    /* Filling in increasing i keeps each row sorted; start[j] walks to the
-     * end of row j and is shifted back afterwards. */
-    for (size_t i = from_lo; i < from_hi; i++)
-        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            size_t j = (size_t)src->j[k];
-            if (j >= to_lo && j < to_hi) {
-                size_t m = dst->start[j]++;
-                dst->j[m] = (int)i;
-                dst->r2[m] = src->r2[k];
+    /* Each thread transposes a contiguous block of source rows: it counts
+     * its pairs per destination row, then fills them at an offset after
+     * those of the threads before it, so every row stays sorted by i. */
+    const int ntmax = omp_get_max_threads();
+    size_t *cnt = calloc((size_t)ntmax * m + 1, sizeof *cnt);
+    if (!cnt)
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
+    int fail = 0;
+#pragma omp parallel num_threads(ntmax)
+    {
+        int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        size_t lo = from_lo + (from_hi - from_lo) * (size_t)t / (size_t)nt;
+        size_t hi = from_lo + (from_hi - from_lo) * (size_t)(t + 1) / (size_t)nt;
+        size_t *c = cnt + (size_t)t * m;
+        for (size_t i = lo; i < hi; i++)
+            for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+                size_t j = (size_t)src->j[k];
+                if (j >= to_lo && j < to_hi)
+                    c[j - to_lo]++;
             }
+#pragma omp barrier
+#pragma omp single
+        {
+            /* row offsets, and each thread's count turned into its offset */
+            dst->start[0] = 0;
+            for (size_t j = 0; j < n; j++) {
+                size_t at = dst->start[j];
+                if (j >= to_lo && j < to_hi)
+                    for (int q = 0; q < nt; q++) {
+                        size_t cq = cnt[(size_t)q * m + (j - to_lo)];
+                        cnt[(size_t)q * m + (j - to_lo)] = at;
+                        at += cq;
+                    }
+                dst->start[j + 1] = at;
+            }
+            size_t npairs = dst->start[n], cap = dst->cap_pairs, cap2 = dst->cap_pairs;
+            if (grow((void **)&dst->j, &cap, npairs + 1, sizeof(int)) ||
+                grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
+                fail = 1;
+            else
+                dst->cap_pairs = cap < cap2 ? cap : cap2;
         }
-    for (size_t j = n; j > 0; j--)
-        dst->start[j] = dst->start[j - 1];
-    dst->start[0] = 0;
+        if (!fail)
+            for (size_t i = lo; i < hi; i++)
+                for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+                    size_t j = (size_t)src->j[k];
+                    if (j >= to_lo && j < to_hi) {
+                        size_t at = c[j - to_lo]++;
+                        dst->j[at] = (int)i;
+                        dst->r2[at] = src->r2[k];
+                    }
+                }
+    }
+    free(cnt);
+    if (fail)
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs",
+                           dst->start[n]);
     return MPS_OK;
 }
 

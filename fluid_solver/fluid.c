@@ -154,6 +154,9 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     st = fluid_linsolve_create(&f->ls, prm->ppe_solver, prm->ppe_rtol, prm->ppe_max_iter, 0, err);
     if (!st)
         st = fluid_linsolve_set_drop(f->ls, prm->ppe_drop, err);
+    /* fluid_ppe_assemble writes sorted rows with their diagonal */
+    if (!st)
+        fluid_linsolve_trust_structure(f->ls, 1);
     if (st)
         goto fail;
     *out = f;

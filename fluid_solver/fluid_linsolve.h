@@ -49,6 +49,13 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
 enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
                                         struct mps_err *err);
 
+/* For a caller whose matrices are well formed by construction (sorted
+ * columns in range, the diagonal stored: the fluid's PPE assembly): the
+ * iterative methods then skip the row-by-row structure check before each
+ * solve (1-2% of a fluid step). Non-finite values are still caught, through
+ * the initial residual, and reported row by row as without it. */
+void fluid_linsolve_trust_structure(struct fluid_linsolve *s, int trusted);
+
 /* Solves A x = b. On entry x holds the initial guess (iterative methods start
  * from it: warm start from the previous step's pressure); on exit the
  * solution. */

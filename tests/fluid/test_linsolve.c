@@ -520,8 +520,12 @@ static void test_errors(void)
     CHECK(st.iterations == 3 && st.residual > 1e-10);
     fluid_linsolve_destroy(&s);
 
-    for (int k = 0; k < NMETHODS; k++) {
+    /* each method, then (2 * NMETHODS) each again trusting the structure:
+     * the values must still be caught and the row named */
+    for (int kk = 0; kk < 2 * NMETHODS; kk++) {
+        int k = kk % NMETHODS;
         CHECK(fluid_linsolve_create(&s, methods[k], 1e-8, 1000, 0, &err) == MPS_OK);
+        fluid_linsolve_trust_structure(s, kk >= NMETHODS);
         char row[32];
         /* NaN in A (an off-diagonal entry of row 17) */
         int pos = m.rowptr[17];
