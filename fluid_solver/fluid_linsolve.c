@@ -19,8 +19,8 @@ static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "
 /* "auto" = pcg_sic0 since the real PPE of the 3 mm dam break was measured
  * (docs/ppe_solvers.md): the same iterations' worth of accuracy for 19% less
  * PPE time on one thread, 22% on two (the factor of the pruned matrix costs
- * half). Before that, pcg_ic0, from these synthetic figures. Measured with bench/linsolve_bench on the synthetic PPE
- * (jittered lattice, ~46 nnz/row, rtol 1e-6, min of 3 runs; see
+ * half). Before that, pcg_ic0, from these synthetic figures. Measured with
+ * bench/linsolve_bench on the synthetic PPE (jittered lattice, ~46 nnz/row, rtol 1e-6, min of 3 runs; see
  * docs/ppe_solvers.md), warm-started solve in ms at n = 5k / 20k / 80k:
  *   2 threads, quiet machine: pcg_ic0 4.6 / 22 / 137, pcg_jacobi 4.3 / 24 / 111
  *   1 thread (what 2 threads give, at best, next to another busy process):
@@ -170,9 +170,8 @@ static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struc
         s->lptr = grow(s->lptr, c + 1, sizeof *s->lptr, &fail);
         s->mark = grow(s->mark, c, sizeof *s->mark, &fail);
         s->linv = grow(s->linv, c, sizeof *s->linv, &fail);
-    }
-    if (uses_ic0(s))
         s->comp = grow(s->comp, c, sizeof *s->comp, &fail);
+    }
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate work vectors for %zu rows",
                            method_names[s->method], n);
@@ -369,8 +368,11 @@ static enum mps_status describe_bad_row(const struct fluid_linsolve *s, const st
                        x ? x[i] : NAN);
 }
 
+/* scan_rows = 0 checks only the arguments, not every row (a trusted
+ * caller, fluid_linsolve_trust_structure). */
 static enum mps_status check_input(const struct fluid_linsolve *s, const struct fluid_csr *A,
-                                   const double *b, const double *x, struct mps_err *err)
+                                   const double *b, const double *x, int scan_rows,
+                                   struct mps_err *err)
 {
     const char *mn = method_names[s->method];
     if (A->n < 0)
@@ -379,6 +381,8 @@ static enum mps_status check_input(const struct fluid_linsolve *s, const struct 
         return mps_err_set(err, MPS_EINPUT, "%s: matrix or right-hand side array is NULL", mn);
     if (A->n > 0 && A->rowptr[0] != 0)
         return mps_err_set(err, MPS_EINPUT, "%s: rowptr[0] = %d: must be 0", mn, A->rowptr[0]);
+    if (!scan_rows)
+        return MPS_OK;
     int n = A->n, bad = n;
 #pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static) \
     reduction(min : bad)
@@ -778,7 +782,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
     if (!isfinite(rb[0]) || !isfinite(rb[1])) {
         /* a non-finite value in A, b or x (a trusted caller skipped the
          * check): find and name it */
-        enum mps_status bad = check_input(s, A, b, x, err);
+        enum mps_status bad = check_input(s, A, b, x, 1, err);
         return bad ? bad
                    : mps_err_set(err, MPS_ESOLVE, "%s: initial residual is not finite",
                                  method_names[s->method]);
@@ -1048,9 +1052,8 @@ enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct flui
     if (!s || !A || (A->n > 0 && !x))
         return mps_err_set(err, MPS_EINPUT, "fluid_linsolve_solve: NULL solver, matrix or x");
     int iterative = s->method == M_PCG_JACOBI || uses_ic0(s);
-    enum mps_status rc = iterative && s->trusted && A->n > 0 && A->rowptr && A->col && A->val && b
-                             ? MPS_OK
-                             : check_input(s, A, b, iterative ? x : NULL, err);
+    enum mps_status rc =
+        check_input(s, A, b, iterative ? x : NULL, !(iterative && s->trusted), err);
     if (rc || A->n == 0)
         return rc;
     return iterative ? pcg(s, A, b, x, st, err) : direct(s, A, b, x, st, err);
