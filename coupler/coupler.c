@@ -84,6 +84,50 @@ static void on_signal(int sig)
 
 /* ---- waiting, with an eye on both children and Ctrl-C ---- */
 
+/* MPS_EPEER naming the first launched solver that has exited, and how, if
+ * one has; MPS_OK otherwise. what: what the coupler was doing. */
+static enum mps_status peer_gone(struct coupler *c, const char *what, struct mps_err *err)
+{
+    for (int q = 0; q < NPEERS; q++)
+        if (c->p[q].active && launch_poll(&c->p[q].child)) {
+            char how[256];
+            launch_describe(&c->p[q].child, how, sizeof how);
+            snprintf(c->failed_peer, sizeof c->failed_peer, "%s", c->p[q].name);
+            c->p[q].active = 0;
+            return mps_err_set(err, MPS_EPEER, "%s solver %s while the coupler %s",
+                               c->p[q].name, how, what);
+        }
+    return MPS_OK;
+}
+
+/* Sends m to peer k. A PAIR socket only blocks a send while no peer is
+ * connected, so the send waits for room in slices, as wait_msg does: a
+ * solver that died while idle is then named at once instead of running
+ * into the link's send timeout. */
+static enum mps_status send_msg(struct coupler *c, int k, const struct proto_msg *m,
+                                struct mps_err *err)
+{
+    char what[64];
+    snprintf(what, sizeof what, "was sending %s", proto_type_name(m->type));
+    double t0 = mps_wall_seconds();
+    for (;;) {
+        zmq_pollitem_t item = {c->p[k].sock, 0, ZMQ_POLLOUT, 0};
+        int rc = zmq_poll(&item, 1, SLICE_MS);
+        /* room, an error proto_link_send will report, or the link's own
+         * deadline reached: its send then times out with its message */
+        if (rc > 0 || (rc < 0 && zmq_errno() != EINTR) ||
+            mps_wall_seconds() - t0 > 1e-3 * PROTO_SEND_TIMEOUT_MS)
+            break;
+        if (interrupted)
+            return mps_err_set(err, MPS_EINTR, "interrupted by signal %d at t = %.6g s",
+                               interrupted, c->time);
+        enum mps_status st = peer_gone(c, what, err);
+        if (st)
+            return st;
+    }
+    return proto_link_send(c->p[k].sock, m, err);
+}
+
 /* Waits for a message from peer k within timeout_s. Meanwhile a message from
  * the other peer can only be an unasked ERROR, and a child that exits is
  * reported by name. */
@@ -144,15 +188,10 @@ static enum mps_status wait_msg(struct coupler *c, int k, struct proto_msg *m, d
         }
         if (st != MPS_ETIMEOUT && st != MPS_EINTR)
             return st;
-        for (int q = 0; q < NPEERS; q++)
-            if (c->p[q].active && launch_poll(&c->p[q].child)) {
-                char how[256];
-                launch_describe(&c->p[q].child, how, sizeof how);
-                snprintf(c->failed_peer, sizeof c->failed_peer, "%s", c->p[q].name);
-                c->p[q].active = 0;
-                return mps_err_set(err, MPS_EPEER, "%s solver %s while the coupler waited for %s",
-                                   c->p[q].name, how, what);
-            }
+        char doing[96];
+        snprintf(doing, sizeof doing, "waited for %s", what);
+        if ((st = peer_gone(c, doing, err)))
+            return st;
         if (mps_wall_seconds() - t0 > timeout_s) {
             snprintf(c->failed_peer, sizeof c->failed_peer, "%s", c->p[k].name);
             return mps_err_set(err, MPS_ETIMEOUT,
@@ -269,7 +308,9 @@ static enum mps_status exchange(struct coupler *c, int k, struct proto_msg *adv,
 {
     struct peer *p = &c->p[k];
     double t0 = mps_wall_seconds();
-    enum mps_status st = proto_link_send(p->sock, adv, err);
+    enum mps_status st = send_msg(c, k, adv, err);
+    if (st == MPS_EPEER || st == MPS_EINTR)
+        return st;
     if (st)
         return mps_err_prefix(err, "sending ADVANCE to the %s solver: ", p->name);
     if ((st = expect(c, k, res, PROTO_RESULT, c->step_timeout, err)))
@@ -439,7 +480,7 @@ static enum mps_status stop_all(struct coupler *c, struct mps_err *err)
         struct proto_msg s = proto_msg_make(PROTO_STOP), m = {0};
         s.step = c->step;
         s.time = c->time;
-        enum mps_status st = proto_link_send(p->sock, &s, err);
+        enum mps_status st = send_msg(c, k, &s, err);
         if (!st)
             st = expect(c, k, &m, PROTO_BYE, 60.0, err);
         if (st)

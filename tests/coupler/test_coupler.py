@@ -118,8 +118,11 @@ def t_solid_hang():
     check(time.time() - t0 < 30, 'the hang is noticed at the deadline')
 
 
-def t_fluid_killed():
-    out = tempfile.mkdtemp(prefix='cpl_kill_')
+def kill_mid_run(which, prefix):
+    """Starts a long run with the fake solid, SIGKILLs the coupler's child
+    whose command line holds `which` once the run steps, and returns
+    (out, returncode, stderr, seconds from the kill to the coupler's exit)."""
+    out = tempfile.mkdtemp(prefix=prefix)
     # long enough that it is still running when we strike
     p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
                           '--set', 'end_time=20'], stderr=subprocess.PIPE, text=True)
@@ -128,17 +131,31 @@ def t_fluid_killed():
         time.sleep(0.1)
         if os.path.exists(os.path.join(out, 'probes.csv')) and len(probes(out)) > 3:
             break
-    # the fluid is the coupler's child whose command line says fluid_solver
     kids = subprocess.run(['pgrep', '-P', str(p.pid)], capture_output=True, text=True).stdout.split()
     for k in kids:
         with open(f'/proc/{k}/cmdline', 'rb') as f:
-            if b'fluid_solver' in f.read():
+            if which in f.read():
                 pid = int(k)
-    check(pid is not None, 'found the running fluid solver')
+    check(pid is not None, f'found the running {which.decode()}')
+    t0 = time.time()
     if pid:
         os.kill(pid, signal.SIGKILL)
     err = p.communicate(timeout=60)[1]
-    after_failure(out, p.returncode, err, 'fluid solver was killed by signal 9')
+    return out, p.returncode, err, time.time() - t0
+
+
+def t_fluid_killed():
+    out, rc, err, _ = kill_mid_run(b'fluid_solver', 'cpl_kill_')
+    after_failure(out, rc, err, 'fluid solver was killed by signal 9')
+
+
+def t_solid_killed():
+    """The solid idles while the fluid steps, so it dies between exchanges:
+    the coupler must name it when it next sends, not wait out the link's
+    10 s send timeout."""
+    out, rc, err, waited = kill_mid_run(b'fake_solid', 'cpl_skill_')
+    after_failure(out, rc, err, 'solid solver was killed by signal 9')
+    check(waited < 5.0, f'noticed {waited:.1f} s after the kill (send timeout: 10 s)')
 
 
 def t_interrupt():
