@@ -154,10 +154,11 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
                 double dx = g->xs[k][0] - xi, dy = g->xs[k][1] - yi;
                 double r2 = dx * dx + dy * dy;
                 size_t j = g->sorted[k];
-                if (r2 < r2max && j != i) {
-                    jtmp[m] = (int)j;
-                    r2tmp[m++] = r2;
-                }
+                /* written always, kept by advancing m: a third of the
+                 * candidates pass, in no learnable order */
+                jtmp[m] = (int)j;
+                r2tmp[m] = r2;
+                m += (r2 < r2max) & (j != i);
             }
             if (m > runs[nruns])
                 runs[++nruns] = m;
@@ -354,13 +355,17 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
     dst->cap_pairs = cap < cap2 ? cap : cap2;
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++) {
-        size_t m = dst->start[i];
+        /* Every candidate is written and kept by advancing m (which of
+         * them pass has no order a branch predictor could learn); the
+         * m < end test fails only once the row is full. */
+        size_t m = dst->start[i], end = dst->start[i + 1];
         for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
             double r2 = src->r2[k];
-            if (r2 < r2max) {
+            if (m < end) {
                 dst->j[m] = src->j[k];
-                dst->r2[m++] = r2;
+                dst->r2[m] = r2;
             }
+            m += r2 < r2max;
         }
     }
     return MPS_OK;

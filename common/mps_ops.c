@@ -41,7 +41,7 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
                            const double (*f)[MPS_DIM], double (*lap)[MPS_DIM])
 {
     const struct mps_nbr_list *nl = in->nl;
-    const double re2 = in->re * in->re, coef = 2.0 * MPS_DIM / (lambda * n0);
+    const double coef = 2.0 * MPS_DIM / (lambda * n0);
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
@@ -56,9 +56,7 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
                 double dx = in->x[j][d] - in->x[i][d];
                 r2 += dx * dx;
             }
-            if (r2 >= re2)
-                continue;
-            double w = mps_weight(sqrt(r2), in->re);
+            double w = mps_weight_r2(r2, in->re);
             for (int d = 0; d < MPS_DIM; d++)
                 acc[d] += (f[j][d] - f[i][d]) * w;
         }

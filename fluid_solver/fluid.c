@@ -40,6 +40,7 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "div_vstar", 1, MPS_F64, (void **)&f->div, "1/s", 0);
     mps_particles_add_field(ps, "ncount", 1, MPS_I32, (void **)&f->ncount, "", 0);
     mps_particles_add_field(ps, "row", 1, MPS_I32, (void **)&f->row, "", 0);
+    mps_particles_add_field(ps, "ppe_nbrs", 1, MPS_I32, (void **)&f->nwlap, "", 0);
     mps_particles_add_field(ps, "has_p", 1, MPS_U8, (void **)&f->has_p, "", 0);
     mps_particles_add_field(ps, "is_fluid", 1, MPS_U8, (void **)&f->is_fluid, "", 0);
     mps_particles_add_field(ps, "nbr_query", 1, MPS_U8, (void **)&f->nbr_query, "", 0);
@@ -177,6 +178,7 @@ void fluid_destroy(struct fluid **pf)
     mps_nbr_list_free(&f->nl_n);
     mps_nbr_list_free(&f->nl_tank);
     free(f->wlap);
+    free(f->wcol);
     free(f->rowptr);
     free(f->col);
     free(f->val);

@@ -68,8 +68,10 @@ struct fluid {
     struct mps_nbr_list nl_n;     /* re_n, filtered from nl at x* */
     struct mps_nbr_list nl_tank;  /* Neumann walls: the fluid neighbours of each tank
                                    * particle (nl has no rows for them) */
-    double *wlap;                 /* Laplacian weight of each nl pair at x* (PPE) */
+    double *wlap;                 /* c w_ij at x* of the PPE row's Laplacian neighbours, */
+    int *wcol;                    /* and their indices, packed from each nl row's start */
     size_t cap_wlap;
+    int *nwlap;                   /* per particle: how many of them (a field) */
     double skin;
     /* PPE */
     int nrows;

@@ -407,12 +407,27 @@ static inline void block(int n, int *lo, int *hi)
     *hi = (int)((long long)n * (t + 1) / nt);
 }
 
+/* Four partial sums: with one, a row of ~50 entries is a chain of ~50
+ * dependent additions. Measured on the 3 mm dam break, 2 threads: the PPE
+ * solve 2.88 to 2.66 ms per step, same iterations. The order is fixed, so
+ * results stay reproducible (but differ from a one-sum product in the last
+ * bits). */
 static inline double row_dot(const struct fluid_csr *A, int i, const double *v)
 {
-    double acc = 0.0;
-    for (int k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
-        acc += A->val[k] * v[A->col[k]];
-    return acc;
+    const int hi = A->rowptr[i + 1];
+    const int *col = A->col;
+    const double *val = A->val;
+    double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
+    int k = A->rowptr[i];
+    for (; k + 4 <= hi; k += 4) {
+        a0 += val[k] * v[col[k]];
+        a1 += val[k + 1] * v[col[k + 1]];
+        a2 += val[k + 2] * v[col[k + 2]];
+        a3 += val[k + 3] * v[col[k + 3]];
+    }
+    for (; k < hi; k++)
+        a0 += val[k] * v[col[k]];
+    return (a0 + a1) + (a2 + a3);
 }
 
 /* Sums slot `which` of the nused threads' partials. */

@@ -19,9 +19,10 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     return 0;
 }
 
-/* Pass 1 for row particle i: caches c w_ij in f->wlap for every Laplacian
- * neighbour that enters row i (0 for the others), returns the number of
- * unknown neighbours and the diagonal in *diag.
+/* Pass 1 for row particle i: packs the Laplacian neighbours that enter row i
+ * (nonzero weight) at the front of its range of the list, their index in
+ * f->wcol and c w_ij in f->wlap; returns their number in *nw, the number of
+ * unknown neighbours, and the diagonal in *diag.
  * Paper walls (4.3): the neighbours that carry a pressure (fluid, wall, solid
  * surface); dummy particles are left out.
  * Neumann walls: fluid neighbours enter as unknowns (or P = 0 on the free
@@ -29,37 +30,39 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
  * P_j = P_i + rho g.(x_j - x_i), so their P_i - P_j is known and goes to
  * the right-hand side (pass 2), not to the diagonal.
  * solid_ppe: the solid surface as in the paper, the tank as with Neumann
- * walls. f->unknown and f->ghost (fluid_update_masks) hold who is which. */
-static int row_weights(struct fluid *f, size_t i, double c, double *diag)
+ * walls. f->unknown and f->ghost (fluid_update_masks) hold who is which.
+ * The loop has no data-dependent branch: a third of the skin list lies
+ * beyond re, in an order the branch predictor cannot learn, so every
+ * candidate is computed, masked and written, the write position advancing
+ * only for kept ones; pass 2 then walks only the kept ones. Measured on the
+ * 3 mm dam break, 2 threads: 1.60 to 1.52 ms per step for the assembly
+ * (the same branch-free weight took the viscous Laplacian from 1.00 to
+ * 0.65 ms). */
+static int row_weights(struct fluid *f, size_t i, double c, double *diag, int *nw)
 {
-    const double re = f->prm.re_lap * f->prm.dp, re2 = re * re;
+    const double re = f->prm.re_lap * f->prm.dp;
     const int ghosts = f->prm.wall_bc != FLUID_WALL_PPE;
-    int m = 0;
+    const size_t k0 = f->nl.start[i];
+    int m = 0, q = 0;
     double dsum = 0.0, mom[2] = {0.0, 0.0}, srf[2] = {0.0, 0.0}, ws = 0.0;
-    for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
+    for (size_t k = k0; k < f->nl.start[i + 1]; k++) {
         int j = f->nl.j[k];
-        double cw = 0.0;
-        if (f->unknown[j] || f->ghost[j]) {
-            double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
-            double r2 = dx * dx + dy * dy;
-            if (r2 < re2) {
-                cw = c * mps_weight(sqrt(r2), re);
-                if (f->unknown[j]) {
-                    dsum += cw;
-                    /* same predicate as pass 2: r == re rounds to w = 0 */
-                    m += cw > 0.0 && f->row[j] >= 0;
-                }
-                mom[0] += cw * dx;
-                mom[1] += cw * dy;
-                if (f->is_fluid[j] && f->surface[j]) {
-                    srf[0] += cw * dx;
-                    srf[1] += cw * dy;
-                    ws += cw;
-                }
-            }
-        }
-        f->wlap[k] = cw;
+        double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
+        double cw = c * mps_weight_r2(dx * dx + dy * dy, re) * (f->unknown[j] | f->ghost[j]);
+        double cu = cw * f->unknown[j], cs = cw * (f->is_fluid[j] & f->surface[j]);
+        dsum += cu;
+        /* same predicate as pass 2: r == re rounds to w = 0 */
+        m += (cu > 0.0) & (f->row[j] >= 0);
+        mom[0] += cw * dx;
+        mom[1] += cw * dy;
+        srf[0] += cs * dx;
+        srf[1] += cs * dy;
+        ws += cs;
+        f->wcol[k0 + q] = j;
+        f->wlap[k0 + q] = cw;
+        q += cw > 0.0;
     }
+    *nw = q;
     double mn = sqrt(mom[0] * mom[0] + mom[1] * mom[1]);
     if (ghosts && f->prm.surface_closure && ws > 0.0 && mn > 0.0) {
         /* Free-surface closure: the neighbours missing beyond the free surface
@@ -107,14 +110,18 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     /* pass 1: weights, and entries per row (+1 for the diagonal); the
      * diagonal sum goes to rhs temporarily */
     size_t npairs = f->nl.start[f->nl.n];
-    if (grow((void **)&f->wlap, &f->cap_wlap, npairs + 1, sizeof(double)))
+    size_t wcap = f->cap_wlap;
+    if (grow((void **)&f->wlap, &wcap, npairs + 1, sizeof(double)) ||
+        grow((void **)&f->wcol, &f->cap_wlap, npairs + 1, sizeof(int)))
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %zu pairs", npairs);
+    if (wcap < f->cap_wlap)
+        f->cap_wlap = wcap;
     int *rowptr = f->rowptr;
     rowptr[0] = 0;
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++)
         if (f->row[i] >= 0)
-            rowptr[f->row[i] + 1] = row_weights(f, i, c, &f->rhs[f->row[i]]) + 1;
+            rowptr[f->row[i] + 1] = row_weights(f, i, c, &f->rhs[f->row[i]], &f->nwlap[i]) + 1;
     for (int r = 0; r < nrows; r++)
         rowptr[r + 1] += rowptr[r];
     size_t nnz = (size_t)rowptr[nrows], ccap = f->cap_nnz, vcap = f->cap_nnz;
@@ -136,10 +143,9 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         double *vals = f->val + s, diag = f->rhs[r];
         int q = 1;
         double ghost = 0.0;
-        for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
-            int j = f->nl.j[k];
-            if (f->wlap[k] == 0.0)
-                continue;
+        const size_t k0 = f->nl.start[i];
+        for (size_t k = k0; k < k0 + (size_t)f->nwlap[i]; k++) {
+            int j = f->wcol[k];
             if (f->row[j] >= 0) {
                 cols[q] = f->row[j];
                 vals[q++] = -f->wlap[k];

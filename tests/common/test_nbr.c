@@ -260,6 +260,18 @@ static void test_kernel(void)
     CHECK(mps_weight(re, re) == 0.0);
     CHECK(mps_weight(1.5 * re, re) == 0.0);
     CHECK_NEAR(mps_weight(0.5 * re, re), 1.0, 1e-15);
+
+    /* The branch-free form the neighbour loops use gives the same bits from
+     * r^2, including 0 at r = 0 and at and beyond re. */
+    CHECK(mps_weight_r2(0.0, re) == 0.0);
+    CHECK(mps_weight_r2(re * re, re) == 0.0);
+    CHECK(mps_weight_r2(2.25 * re * re, re) == 0.0);
+    int same = 1;
+    for (int k = 1; k <= 2000; k++) {
+        double r = 1.2 * re * k / 2000.0;
+        same &= mps_weight_r2(r * r, re) == mps_weight(sqrt(r * r), re);
+    }
+    CHECK(same);
 }
 
 int main(void)
