@@ -179,6 +179,9 @@ void fluid_destroy(struct fluid **pf)
     mps_nbr_list_free(&f->nl_tank);
     free(f->wlap);
     free(f->wcol);
+    free(f->agg);
+    free(f->aggkey);
+    free(f->aggmap);
     free(f->rowptr);
     free(f->col);
     free(f->val);

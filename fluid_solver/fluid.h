@@ -72,6 +72,11 @@ struct fluid {
     int *wcol;                    /* and their indices, packed from each nl row's start */
     size_t cap_wlap;
     int *nwlap;                   /* per particle: how many of them (a field) */
+    int *agg;                     /* pcg_defl: aggregate of each PPE row */
+    size_t cap_agg;
+    long long *aggkey;            /* scratch: cell of each row, and a cell -> aggregate map */
+    int *aggmap;
+    size_t cap_aggkey, cap_aggmap;
     double skin;
     /* PPE */
     int nrows;

@@ -31,7 +31,9 @@ struct fluid_linsolve_stats {
 struct fluid_linsolve;
 
 /* method: "pcg_jacobi", "pcg_ic0", "pcg_sic0" (IC(0) of a sparsified
- * matrix, see fluid_linsolve_set_drop), "cholmod", "cholmod_reuse" (keeps the
+ * matrix, see fluid_linsolve_set_drop), "pcg_defl" (Jacobi PCG deflated by
+ * aggregates of rows, see fluid_linsolve_set_aggregates), "cholmod",
+ * "cholmod_reuse" (keeps the
  * fill-reducing ordering while the matrix size and pattern allow), "auto"
  * (the measured default). rtol: relative residual for iterative methods.
  * max_iter: iteration cap (an iterative solve that hits it fails with
@@ -48,6 +50,20 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
  * the method. Fails with MPS_EINPUT outside [0, 1). */
 enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
                                         struct mps_err *err);
+
+/* pcg_defl: the aggregate of each of the n rows of the next matrix(es),
+ * agg[i] in [0, nagg), every aggregate non-empty (groups of rows close in
+ * space: the coarse space is their indicator vectors). The array is borrowed:
+ * it must stay valid and unchanged through the solves it is meant for. A
+ * solve of a matrix with another row count, or with none given, uses blocks
+ * of 16 consecutive rows. Fails with MPS_EINPUT naming a bad row. Other
+ * methods ignore it. */
+enum mps_status fluid_linsolve_set_aggregates(struct fluid_linsolve *s, const int *agg, int n,
+                                              int nagg, struct mps_err *err);
+/* 1 if the method uses aggregates (pcg_defl). */
+int fluid_linsolve_uses_aggregates(const struct fluid_linsolve *s);
+/* pcg_defl: size of the last coarse system (0 before the first). */
+int fluid_linsolve_coarse_size(const struct fluid_linsolve *s);
 
 /* For a caller whose matrices are well formed by construction (sorted
  * columns in range, the diagonal stored: the fluid's PPE assembly): the

@@ -63,13 +63,17 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.shifting_max", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "dp",
      "largest shift per step"},
     {"fluid.ppe_solver", MPS_KEY_ENUM, "auto", 0, 0, 0,
-     "auto|pcg_jacobi|pcg_ic0|pcg_sic0|cholmod|cholmod_reuse", "", "linear solver for the PPE"},
+     "auto|pcg_jacobi|pcg_ic0|pcg_sic0|pcg_defl|cholmod|cholmod_reuse", "",
+     "linear solver for the PPE"},
     {"fluid.ppe_rtol", MPS_KEY_DOUBLE, "1e-6", 0, 0.1, MPS_KEY_LO_OPEN, NULL, "",
      "relative residual of iterative PPE solves"},
     {"fluid.ppe_max_iter", MPS_KEY_INT, "2000", 1, 0, NOHI, NULL, "", "iteration cap"},
     {"fluid.ppe_drop", MPS_KEY_DOUBLE, "0.015", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
      "pcg_sic0: couplings with a_ij^2 < drop^2 a_ii a_jj are left out of the incomplete "
      "Cholesky factor (added to the diagonal); 0 keeps all (docs/ppe_solvers.md)"},
+    {"fluid.ppe_coarse_cell", MPS_KEY_DOUBLE, "4", 1, 100, 0, NULL, "dp",
+     "pcg_defl: side of the square cells whose PPE rows form one aggregate of the coarse "
+     "space (docs/ppe_solvers.md)"},
     /* not REQUIRED in the schema: a solid-only case has no tank; the fluid
      * checks for it in fluid_params_read */
     {"fluid.tank.width", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "m",
@@ -151,6 +155,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");
     p->ppe_max_iter = (int)mps_case_int(c, "fluid.ppe_max_iter");
     p->ppe_drop = mps_case_double(c, "fluid.ppe_drop");
+    p->ppe_coarse_cell = mps_case_double(c, "fluid.ppe_coarse_cell");
     if (!mps_case_has(c, "fluid.tank.width") || !mps_case_has(c, "fluid.tank.height"))
         return mps_err_set(err, MPS_EINPUT, "%s: missing required key '%s' (the fluid needs a tank)",
                            mps_case_path(c),

@@ -56,6 +56,7 @@ struct fluid_params {
     double ppe_rtol;
     int ppe_max_iter;
     double ppe_drop;       /* pcg_sic0 drop threshold */
+    double ppe_coarse_cell;       /* pcg_defl aggregate cell side, in dp */
     double tank_w, tank_h;
     int tank_lid;
     int wall_layers;              /* wall + dummy layers, >= 3 */

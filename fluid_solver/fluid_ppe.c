@@ -176,11 +176,81 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     return MPS_OK;
 }
 
+static int cmp_key_row(const void *a, const void *b)
+{
+    const long long *x = a, *y = b;
+    return x[0] < y[0] ? -1 : x[0] > y[0] ? 1 : (x[1] > y[1]) - (x[1] < y[1]);
+}
+
+/* pcg_defl's aggregates: the PPE rows in each square cell of side
+ * fluid.ppe_coarse_cell spacings (at x*), numbered as they first appear in
+ * particle order (which is roughly cell order). A direct cell -> aggregate
+ * map when the rows' bounding box has few enough cells, else a sort. */
+static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err *err)
+{
+    const size_t n = f->ps.n, nr = (size_t)f->nrows;
+    const double h = f->prm.ppe_coarse_cell * f->prm.dp;
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (size_t i = 0; i < n; i++)
+        if (f->row[i] >= 0)
+            for (int d = 0; d < 2; d++) {
+                lo[d] = f->x[i][d] < lo[d] ? f->x[i][d] : lo[d];
+                hi[d] = f->x[i][d] > hi[d] ? f->x[i][d] : hi[d];
+            }
+    const double nxd = floor((hi[0] - lo[0]) / h) + 1.0, nyd = floor((hi[1] - lo[1]) / h) + 1.0;
+    const int direct = nxd * nyd <= 16.0 * (double)nr + 65536.0;
+    const size_t ncell = direct ? (size_t)nxd * (size_t)nyd : 0, nx = (size_t)nxd;
+    if (grow((void **)&f->agg, &f->cap_agg, nr + 1, sizeof *f->agg) ||
+        grow((void **)&f->aggkey, &f->cap_aggkey, 2 * nr + 2, sizeof *f->aggkey) ||
+        (direct && grow((void **)&f->aggmap, &f->cap_aggmap, ncell + 1, sizeof *f->aggmap)))
+        return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for the coarse space");
+    int m = 0;
+    if (direct) {
+        for (size_t c = 0; c < ncell; c++)
+            f->aggmap[c] = -1;
+        for (size_t i = 0; i < n; i++) {
+            int r = f->row[i];
+            if (r < 0)
+                continue;
+            size_t cx = (size_t)((f->x[i][0] - lo[0]) / h), cy = (size_t)((f->x[i][1] - lo[1]) / h);
+            int *a = &f->aggmap[cy * nx + cx];
+            if (*a < 0)
+                *a = m++;
+            f->agg[r] = *a;
+        }
+    } else {
+        for (size_t i = 0, k = 0; i < n; i++) {
+            if (f->row[i] < 0)
+                continue;
+            long long cx = (long long)((f->x[i][0] - lo[0]) / h);
+            long long cy = (long long)((f->x[i][1] - lo[1]) / h);
+            f->aggkey[2 * k] = cy * (long long)(nxd + 1.0) + cx;
+            f->aggkey[2 * k++ + 1] = f->row[i];
+        }
+        qsort(f->aggkey, nr, 2 * sizeof *f->aggkey, cmp_key_row);
+        for (size_t k = 0; k < nr; k++) {
+            m += k > 0 && f->aggkey[2 * k] != f->aggkey[2 * k - 2];
+            f->agg[f->aggkey[2 * k + 1]] = m;
+        }
+        m += nr > 0;
+    }
+    *nagg = m;
+    return MPS_OK;
+}
+
 enum mps_status fluid_ppe_solve(struct fluid *f, struct fluid_linsolve_stats *stats,
                                 struct mps_err *err)
 {
     struct fluid_csr A = {f->nrows, f->rowptr, f->col, f->val};
     enum mps_status st = MPS_OK;
+    if (f->nrows > 0 && fluid_linsolve_uses_aggregates(f->ls)) {
+        int nagg = 0;
+        st = ppe_aggregates(f, &nagg, err);
+        if (!st)
+            st = fluid_linsolve_set_aggregates(f->ls, f->agg, f->nrows, nagg, err);
+        if (st)
+            return st;
+    }
     if (f->nrows > 0) {
         st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, stats, err);
         if (st)

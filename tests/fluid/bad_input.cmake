@@ -22,6 +22,8 @@ fluid_expect_fail(fluid_bad_end_time_zero "end_time = 0: must be > 0"
                   ${FS} ${DB} ${OUT} --set end_time=0)
 fluid_expect_fail(fluid_bad_cfl "fluid.dt_min = 0.01: the CFL condition \\(Eq. 52\\) needs dt <="
                   ${FS} ${DB} ${OUT} --set fluid.dt_min=0.01 --set fluid.dt_max=0.02)
+fluid_expect_fail(fluid_bad_coarse_cell "fluid.ppe_coarse_cell = 0.5: must be in \\[1, 100\\]"
+                  ${FS} ${DB} ${OUT} --set fluid.ppe_coarse_cell=0.5)
 fluid_expect_fail(fluid_bad_unknown_key_in_file "tests/fluid/bad_key.yml:6: fluid.bogus = 1: unknown key"
                   ${FS} tests/fluid/bad_key.yml ${OUT})
 fluid_expect_fail(coupler_bad_negative_dp "coupler: .*dp = -0.004: must be > 0"

@@ -10,8 +10,8 @@
 #include "../test_util.h"
 
 static const char *const methods[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse", "auto",
-                                      "pcg_sic0"};
-#define NMETHODS 6
+                                      "pcg_sic0", "pcg_defl"};
+#define NMETHODS 7
 
 struct mat {
     int n, *rowptr, *col;
@@ -464,6 +464,100 @@ static void test_sparsified_ic0(void)
     }
 }
 
+/* Aggregates of the lattice's unknowns (row-major, nx per row): squares of
+ * h x h particles. */
+static int *square_aggregates(int n, int nx, int h, int *nagg)
+{
+    int *agg = malloc((size_t)n * sizeof *agg), per_row = (nx + h - 1) / h;
+    for (int a = 0; a < n; a++)
+        agg[a] = (a / nx / h) * per_row + (a % nx) / h;
+    *nagg = agg[n - 1] + 1;
+    return agg;
+}
+
+/* pcg_defl: with geometric aggregates the iterations stay flat as the
+ * lattice grows (the coarse space takes the smooth modes), while Jacobi
+ * PCG's grow like the lattice's width; the solution is right; bad
+ * aggregates are named. */
+static void test_deflation(void)
+{
+    const double rtol = 1e-8;
+    int its[2][2] = {{0}};   /* [size][jacobi, defl] */
+    for (int big = 0; big < 2; big++) {
+        int nx = big ? 150 : 50, ny = nx + 1;
+        struct mat m;
+        build(&m, nx, ny, 0.1, 0.0, 1e-4);
+        double *b = make_rhs(&m, ny);
+        struct fluid_linsolve_stats st;
+        double *xj = solve_new("pcg_jacobi", &m, b, rtol, &st);
+        its[big][0] = st.iterations;
+        int nagg;
+        int *agg = square_aggregates(m.n, nx, 4, &nagg);
+        struct fluid_linsolve *s = NULL;
+        struct mps_err err = {0};
+        double *x = calloc((size_t)m.n, sizeof *x);
+        CHECK(fluid_linsolve_create(&s, "pcg_defl", rtol, 1000, 0, &err) == MPS_OK);
+        CHECK(fluid_linsolve_uses_aggregates(s));
+        CHECK(fluid_linsolve_set_aggregates(s, agg, m.n, nagg, &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        its[big][1] = st.iterations;
+        CHECK(fluid_linsolve_coarse_size(s) == nagg);
+        double res = relres(&m.csr, b, x);
+        printf("  n = %d: pcg_jacobi %d iterations, pcg_defl (%d aggregates of 4 x 4) %d, "
+               "residual %.2e\n", m.n, its[big][0], nagg, its[big][1], res);
+        CHECK(res <= rtol);
+        CHECK(reldiff(m.n, x, xj) < 1e-5);
+        /* warm start from the solution: nothing to do */
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(st.iterations <= 1);
+        fluid_linsolve_destroy(&s);
+        free(x);
+        free(xj);
+        free(agg);
+        free(b);
+        mat_free(&m);
+    }
+    /* 9x the unknowns: Jacobi needs about 3x the iterations (they go as the
+     * width); with the coarse space they may grow by a third at most. */
+    CHECK(its[1][0] > 2 * its[0][0]);
+    CHECK(3 * its[1][1] <= 4 * its[0][1]);
+    CHECK(3 * its[1][1] < its[1][0]);
+
+    struct mat m;
+    build(&m, 20, 21, 0.1, 0.0, 1e-4);
+    double *b = make_rhs(&m, 21), *x = calloc((size_t)m.n, sizeof *x);
+    struct fluid_linsolve *s = NULL;
+    struct mps_err err = {0};
+    int nagg, *agg = square_aggregates(m.n, 20, 4, &nagg);
+    CHECK(fluid_linsolve_create(&s, "pcg_defl", 1e-8, 1000, 0, &err) == MPS_OK);
+    agg[7] = nagg;
+    CHECK(fluid_linsolve_set_aggregates(s, agg, m.n, nagg, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "row 7") != NULL);
+    agg[7] = -1;
+    CHECK(fluid_linsolve_set_aggregates(s, agg, m.n, nagg, &err) == MPS_EINPUT);
+    CHECK(fluid_linsolve_set_aggregates(s, agg, m.n, 0, &err) == MPS_EINPUT);
+    CHECK(fluid_linsolve_set_aggregates(s, NULL, m.n, nagg, &err) == MPS_EINPUT);
+    /* an aggregate with no row makes the coarse matrix singular: named */
+    agg[7] = agg[6];
+    CHECK(fluid_linsolve_set_aggregates(s, agg, m.n, nagg + 1, &err) == MPS_OK);
+    CHECK(fluid_linsolve_solve(s, &m.csr, b, x, NULL, &err) == MPS_ESOLVE);
+    CHECK(strstr(err.msg, "no row") != NULL);
+    /* aggregates for another row count: the fallback blocks are used */
+    memset(x, 0, (size_t)m.n * sizeof *x);
+    CHECK(fluid_linsolve_set_aggregates(s, agg, m.n - 1, nagg, &err) == MPS_OK);
+    CHECK(fluid_linsolve_solve(s, &m.csr, b, x, NULL, &err) == MPS_OK);
+    CHECK(relres(&m.csr, b, x) <= 1e-8);
+    fluid_linsolve_destroy(&s);
+    /* other methods do not use them */
+    CHECK(fluid_linsolve_create(&s, "pcg_sic0", 1e-8, 1000, 0, &err) == MPS_OK);
+    CHECK(!fluid_linsolve_uses_aggregates(s));
+    fluid_linsolve_destroy(&s);
+    free(agg);
+    free(x);
+    free(b);
+    mat_free(&m);
+}
+
 static void test_zero_rhs(void)
 {
     struct mat m;
@@ -586,6 +680,7 @@ int main(void)
     test_thread_counts_agree();
     test_cholmod_reuse_across_matrices();
     test_sparsified_ic0();
+    test_deflation();
     test_zero_rhs();
     test_errors();
     return test_summary("test_linsolve");
