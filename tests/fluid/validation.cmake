@@ -8,7 +8,10 @@
 #                            tests/fluid/check_dambreak.py and docs/fluid.md);
 #   fluid_stable_dambreak    cases/dambreak, dp = 8 mm, 2 s (the water hits
 #                            the right wall and sloshes back): finishes, no
-#                            particle out, speeds finite.
+#                            particle out, speeds finite;
+#   fluid_ppe_scaling        cases/dambreak at 8 and 2 mm to 0.05 s: the PPE
+#                            iterations stay flat with the default solver
+#                            (tests/fluid/check_ppe_scaling.py).
 set(FV_DIR ${CMAKE_CURRENT_LIST_DIR})
 set(FV_OUT ${CMAKE_BINARY_DIR}/test_out/fluid_validation)
 set(FV_RUN sh ${FV_DIR}/run_and_check.sh)
@@ -28,5 +31,9 @@ add_test(NAME fluid_stable_dambreak
           -- ${FV_SOLVER} cases/dambreak/case.yml --set dp=0.008 --set end_time=2
              --set output.interval=0
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME fluid_ppe_scaling
+  COMMAND /usr/bin/python3 ${FV_DIR}/check_ppe_scaling.py ${FV_SOLVER} ${FV_OUT}/ppe_scaling
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(fluid_valid_hydrostatic fluid_valid_dambreak fluid_stable_dambreak
+  fluid_ppe_scaling
   PROPERTIES LABELS validation TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=1")
