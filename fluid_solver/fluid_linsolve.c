@@ -3,6 +3,8 @@
  * docs/ppe_solvers.md for the measurements behind the choices here. */
 #include "fluid_linsolve.h"
 
+#include "fluid_defl.h"
+
 #include <math.h>
 #include <omp.h>
 #include <stdio.h>
@@ -10,6 +12,8 @@
 #include <string.h>
 
 #include <cholmod.h>
+
+#include "mps_mem.h"
 
 enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE, M_PCG_SIC0, M_PCG_DEFL };
 
@@ -81,24 +85,7 @@ struct fluid_linsolve {
     int nblk;            /* blocks of rows factorised independently (one per thread) */
     double drop2;        /* pcg_sic0: theta^2 of the drop rule (0 for pcg_ic0) */
 
-    /* pcg_defl: aggregates (borrowed from the caller until the next solve),
-     * A Z stored in A's row slots (azlen entries from rowptr[i]), the
-     * factor of E = Z^T A Z, per-thread coarse partial sums */
-    const int *agg;
-    int nagg, agg_n;     /* agg_n: rows the aggregates were given for */
-    int *own_agg;        /* fallback: blocks of consecutive rows */
-    size_t cap_own;
-    int *azlen, *azcol;
-    double *azval;
-    int *amark;          /* per thread, per aggregate: last row seen and its slot */
-    int *ztptr, *ztrow;  /* (A Z)^T in CSR: for each aggregate, the rows that touch it */
-    double *ztval;
-    size_t cap_ztptr, cap_zt;
-    size_t cap_az, cap_azlen, cap_cpart, cap_amark;
-    double *cpart;
-    cholmod_factor *Lc;
-    cholmod_dense *Xc, *Yc, *Ec;
-    int coarse_n;        /* size of the last coarse system (statistics) */
+    struct fluid_defl *defl;   /* pcg_defl: the coarse space (fluid_defl.h) */
 
     /* CHOLMOD */
     int cm_started;
@@ -169,33 +156,23 @@ static inline int uses_ic0(const struct fluid_linsolve *s)
     return s->method == M_PCG_IC0 || s->method == M_PCG_SIC0;
 }
 
-/* realloc that keeps the old block on failure and raises *fail instead, so a
- * batch of arrays can be grown and checked once. */
-static void *grow(void *p, size_t count, size_t elem, int *fail)
-{
-    void *q = realloc(p, (count ? count : 1) * elem);
-    if (!q)
-        *fail = 1;
-    return q ? q : p;
-}
-
 static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struct mps_err *err)
 {
     if (n <= s->cap_n)
         return MPS_OK;
     size_t c = n + n / 8;   /* particles come and go: a little slack avoids churn */
     int fail = 0;
-    s->r = grow(s->r, c, sizeof *s->r, &fail);
-    s->z = grow(s->z, c, sizeof *s->z, &fail);
-    s->p = grow(s->p, c, sizeof *s->p, &fail);
-    s->q = grow(s->q, c, sizeof *s->q, &fail);
-    s->dinv = grow(s->dinv, c, sizeof *s->dinv, &fail);
-    s->diag = grow(s->diag, c, sizeof *s->diag, &fail);
+    s->r = mps_realloc_or_flag(s->r, c, sizeof *s->r, &fail);
+    s->z = mps_realloc_or_flag(s->z, c, sizeof *s->z, &fail);
+    s->p = mps_realloc_or_flag(s->p, c, sizeof *s->p, &fail);
+    s->q = mps_realloc_or_flag(s->q, c, sizeof *s->q, &fail);
+    s->dinv = mps_realloc_or_flag(s->dinv, c, sizeof *s->dinv, &fail);
+    s->diag = mps_realloc_or_flag(s->diag, c, sizeof *s->diag, &fail);
     if (uses_ic0(s)) {
-        s->lptr = grow(s->lptr, c + 1, sizeof *s->lptr, &fail);
-        s->mark = grow(s->mark, c, sizeof *s->mark, &fail);
-        s->linv = grow(s->linv, c, sizeof *s->linv, &fail);
-        s->comp = grow(s->comp, c, sizeof *s->comp, &fail);
+        s->lptr = mps_realloc_or_flag(s->lptr, c + 1, sizeof *s->lptr, &fail);
+        s->mark = mps_realloc_or_flag(s->mark, c, sizeof *s->mark, &fail);
+        s->linv = mps_realloc_or_flag(s->linv, c, sizeof *s->linv, &fail);
+        s->comp = mps_realloc_or_flag(s->comp, c, sizeof *s->comp, &fail);
     }
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate work vectors for %zu rows",
@@ -252,7 +229,14 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
         free(s);
         return mps_err_set(err, MPS_ENOMEM, "cannot allocate the linear solver");
     }
-    if (m == M_CHOLMOD || m == M_CHOLMOD_REUSE || m == M_PCG_DEFL) {
+    if (m == M_PCG_DEFL) {
+        enum mps_status st = fluid_defl_create(&s->defl, s->nthreads, PAR_MIN_ROWS, err);
+        if (st) {
+            fluid_linsolve_destroy(&s);
+            return st;
+        }
+    }
+    if (m == M_CHOLMOD || m == M_CHOLMOD_REUSE) {
         cholmod_msg[0] = '\0';
         if (!cholmod_start(&s->cm)) {
             fluid_linsolve_destroy(&s);
@@ -269,30 +253,22 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
 
 int fluid_linsolve_uses_aggregates(const struct fluid_linsolve *s)
 {
-    return s && s->method == M_PCG_DEFL;
+    return s && s->defl;
 }
 
 enum mps_status fluid_linsolve_set_aggregates(struct fluid_linsolve *s, const int *agg, int n,
                                               int nagg, struct mps_err *err)
 {
-    if (!s || (n > 0 && !agg) || n < 0 || nagg < 1 || nagg > (n > 0 ? n : 1))
-        return mps_err_set(err, MPS_EINPUT,
-                           "fluid_linsolve_set_aggregates: %d aggregates for %d rows: need "
-                           "1 <= aggregates <= rows and an array", nagg, n);
-    for (int i = 0; i < n; i++)
-        if (agg[i] < 0 || agg[i] >= nagg)
-            return mps_err_set(err, MPS_EINPUT,
-                               "fluid_linsolve_set_aggregates: row %d: aggregate %d out of "
-                               "range [0, %d)", i, agg[i], nagg);
-    s->agg = agg;
-    s->agg_n = n;
-    s->nagg = nagg;
-    return MPS_OK;
+    if (!s)
+        return mps_err_set(err, MPS_EINPUT, "fluid_linsolve_set_aggregates: NULL solver");
+    if (!s->defl)
+        return MPS_OK; /* other methods ignore them */
+    return fluid_defl_set_aggregates(s->defl, agg, n, nagg, err);
 }
 
 int fluid_linsolve_coarse_size(const struct fluid_linsolve *s)
 {
-    return s ? s->coarse_n : 0;
+    return s && s->defl ? fluid_defl_coarse_size(s->defl) : 0;
 }
 
 void fluid_linsolve_trust_structure(struct fluid_linsolve *s, int trusted)
@@ -324,10 +300,6 @@ static void free_cholmod_state(struct fluid_linsolve *s)
     cholmod_free_dense(&s->X, &s->cm);
     cholmod_free_dense(&s->Y, &s->cm);
     cholmod_free_dense(&s->E, &s->cm);
-    cholmod_free_factor(&s->Lc, &s->cm);
-    cholmod_free_dense(&s->Xc, &s->cm);
-    cholmod_free_dense(&s->Yc, &s->cm);
-    cholmod_free_dense(&s->Ec, &s->cm);
 }
 
 void fluid_linsolve_destroy(struct fluid_linsolve **sp)
@@ -355,15 +327,7 @@ void fluid_linsolve_destroy(struct fluid_linsolve **sp)
     free(s->perm);
     free(s->pat_ptr);
     free(s->pat_col);
-    free(s->azlen);
-    free(s->azcol);
-    free(s->azval);
-    free(s->cpart);
-    free(s->amark);
-    free(s->ztptr);
-    free(s->ztrow);
-    free(s->ztval);
-    free(s->own_agg);
+    fluid_defl_destroy(&s->defl);
     free(s);
     *sp = NULL;
 }
@@ -789,8 +753,8 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
     if (lnz > s->cap_lnz) {
         size_t c = lnz + lnz / 8;
         int fail = 0;
-        s->lcol = grow(s->lcol, c, sizeof *s->lcol, &fail);
-        s->lval = grow(s->lval, c, sizeof *s->lval, &fail);
+        s->lcol = mps_realloc_or_flag(s->lcol, c, sizeof *s->lcol, &fail);
+        s->lval = mps_realloc_or_flag(s->lval, c, sizeof *s->lval, &fail);
         if (fail)
             return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate the IC(0) factor "
                                                 "(%zu entries)", method_names[s->method], lnz);
@@ -842,274 +806,6 @@ static double ic0_apply(struct fluid_linsolve *s, int n, const double *r, double
     return gather(s, nblk, 0);
 }
 
-
-/* ---------------------------------------------------------------------- */
-/* pcg_defl: Jacobi-preconditioned CG with deflation by aggregates (Saad,
- * Yeung, Erhel & Guyomarc'h 2000; Tang, Nabben, Vuik & Erlangga 2009). Z is
- * the n x m indicator matrix of the aggregates (groups of rows close in
- * space: the fluid gives square cells of a few spacings), E = Z^T A Z the
- * m x m coarse matrix, factorised with CHOLMOD at every solve. The start is
- * corrected so that Z^T r = 0, and every search direction is made
- * A-orthogonal to range(Z): p = z + beta p - Z E^-1 (A Z)^T z. The coarse
- * space carries the smooth pressure modes that make CG's iteration count
- * grow with resolution; Jacobi handles the rest. Measured on the dam break
- * (docs/ppe_solvers.md): iterations stop growing with n. */
-
-/* Fallback aggregates for a caller that gave none: DEFL_BLOCK consecutive
- * rows (particles sorted by cell are roughly local in index). */
-#define DEFL_BLOCK 16
-
-static enum mps_status defl_aggregates(struct fluid_linsolve *s, int n, struct mps_err *err)
-{
-    if (s->agg && s->agg_n == n)
-        return MPS_OK;
-    if ((size_t)n > s->cap_own) {
-        int fail = 0;
-        s->own_agg = grow(s->own_agg, (size_t)n + (size_t)n / 8 + 1, sizeof *s->own_agg, &fail);
-        if (fail)
-            return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate aggregates for %d rows",
-                               n);
-        s->cap_own = (size_t)n + (size_t)n / 8 + 1;
-    }
-    for (int i = 0; i < n; i++)
-        s->own_agg[i] = i / DEFL_BLOCK;
-    s->agg = s->own_agg;
-    s->agg_n = n;
-    s->nagg = (n + DEFL_BLOCK - 1) / DEFL_BLOCK;
-    return MPS_OK;
-}
-
-/* A Z (row i's distinct aggregates and the sums of its entries in each,
- * stored from rowptr[i]), E = Z^T A Z (upper triangle) and its factor. */
-static enum mps_status defl_setup(struct fluid_linsolve *s, const struct fluid_csr *A,
-                                  struct mps_err *err)
-{
-    const int n = A->n;
-    enum mps_status rc = defl_aggregates(s, n, err);
-    if (rc)
-        return rc;
-    const int m = s->nagg, *agg = s->agg;
-    const size_t nnz = (size_t)A->rowptr[n], cp = ((size_t)s->nthreads + 1) * (size_t)m;
-    int fail = 0;
-    if ((size_t)n > s->cap_azlen) {
-        s->azlen = grow(s->azlen, (size_t)n + (size_t)n / 8 + 1, sizeof *s->azlen, &fail);
-        if (!fail)
-            s->cap_azlen = (size_t)n + (size_t)n / 8 + 1;
-    }
-    if (nnz > s->cap_az) {
-        s->azcol = grow(s->azcol, nnz + nnz / 8 + 1, sizeof *s->azcol, &fail);
-        s->azval = grow(s->azval, nnz + nnz / 8 + 1, sizeof *s->azval, &fail);
-        if (!fail)
-            s->cap_az = nnz + nnz / 8 + 1;
-    }
-    if (cp > s->cap_cpart) {
-        s->cpart = grow(s->cpart, cp, sizeof *s->cpart, &fail);
-        if (!fail)
-            s->cap_cpart = cp;
-    }
-    if (2 * cp > s->cap_amark) {
-        s->amark = grow(s->amark, 2 * cp, sizeof *s->amark, &fail);
-        if (!fail)
-            s->cap_amark = 2 * cp;
-    }
-    if (fail)
-        return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate the coarse space (%d rows, "
-                                            "%d aggregates)", n, m);
-    int *azlen = s->azlen, *azcol = s->azcol;
-    double *azval = s->azval;
-    long long total = 0;
-#pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) reduction(+ : total)
-    {
-        /* seen[a] = the last row that met aggregate a, slot[a] its place
-         * in that row: one lookup per entry instead of a search */
-        int *seen = s->amark + 2 * (size_t)omp_get_thread_num() * (size_t)m, *slot = seen + m;
-        for (int a = 0; a < m; a++)
-            seen[a] = -1;
-#pragma omp for schedule(static)
-        for (int i = 0; i < n; i++) {
-            const int base = A->rowptr[i];
-            int len = 0;
-            for (int k = base; k < A->rowptr[i + 1]; k++) {
-                int a = agg[A->col[k]];
-                if (seen[a] != i) {
-                    seen[a] = i;
-                    slot[a] = base + len;
-                    azcol[base + len] = a;
-                    azval[base + len++] = 0.0;
-                }
-                azval[slot[a]] += A->val[k];
-            }
-            azlen[i] = len;
-            total += len;
-        }
-    }
-
-    /* (A Z)^T by rows: the projection's restriction then gathers per
-     * aggregate instead of scattering per row (consecutive rows mostly hit
-     * the same aggregate, and a scatter waits on its own last store) */
-    if ((size_t)m + 1 > s->cap_ztptr) {
-        s->ztptr = grow(s->ztptr, (size_t)m + 1, sizeof *s->ztptr, &fail);
-        if (!fail)
-            s->cap_ztptr = (size_t)m + 1;
-    }
-    if ((size_t)total + 1 > s->cap_zt) {
-        size_t c = (size_t)total + (size_t)total / 8 + 1;
-        s->ztrow = grow(s->ztrow, c, sizeof *s->ztrow, &fail);
-        s->ztval = grow(s->ztval, c, sizeof *s->ztval, &fail);
-        if (!fail)
-            s->cap_zt = c;
-    }
-    if (fail)
-        return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate (A Z)^T (%lld entries)",
-                           total);
-    int *ztptr = s->ztptr;
-    memset(ztptr, 0, ((size_t)m + 1) * sizeof *ztptr);
-    for (int i = 0; i < n; i++)
-        for (int q = 0; q < azlen[i]; q++)
-            ztptr[azcol[A->rowptr[i] + q] + 1]++;
-    for (int a = 0; a < m; a++)
-        ztptr[a + 1] += ztptr[a];
-    for (int i = 0; i < n; i++) {
-        const int base = A->rowptr[i];
-        for (int q = 0; q < azlen[i]; q++) {
-            int at = ztptr[azcol[base + q]]++;
-            s->ztrow[at] = i;
-            s->ztval[at] = azval[base + q];
-        }
-    }
-    for (int a = m; a > 0; a--)
-        ztptr[a] = ztptr[a - 1];
-    ztptr[0] = 0;
-
-    cholmod_common *cm = &s->cm;
-    cholmod_msg[0] = '\0';
-    cholmod_triplet *T = cholmod_allocate_triplet((size_t)m, (size_t)m, (size_t)total, 1,
-                                                  CHOLMOD_REAL, cm);
-    if (!T)
-        return cholmod_fail(s, "cholmod_allocate_triplet", err);
-    int *ti = T->i, *tj = T->j;
-    double *tx = T->x;
-    size_t t = 0;
-    for (int i = 0; i < n; i++) {
-        const int base = A->rowptr[i], ai = agg[i];
-        for (int q = 0; q < azlen[i]; q++)
-            if (ai <= azcol[base + q]) {   /* E is symmetric: its upper triangle */
-                ti[t] = ai;
-                tj[t] = azcol[base + q];
-                tx[t++] = azval[base + q];
-            }
-    }
-    T->nnz = t;
-    cholmod_sparse *E = cholmod_triplet_to_sparse(T, t, cm);
-    cholmod_free_triplet(&T, cm);
-    if (!E)
-        return cholmod_fail(s, "cholmod_triplet_to_sparse", err);
-    cholmod_free_factor(&s->Lc, cm);
-    /* simplicial: no BLAS (see direct() on OpenBLAS threads), and E is
-     * small and sparse; AMD alone, without trying other orderings */
-    int sn = cm->supernodal, nm = cm->nmethods, ord = cm->method[0].ordering;
-    cm->supernodal = CHOLMOD_SIMPLICIAL;
-    cm->nmethods = 1;
-    cm->method[0].ordering = CHOLMOD_AMD;
-    s->Lc = cholmod_analyze(E, cm);
-    int ok = s->Lc && cm->status >= CHOLMOD_OK;
-    if (ok)
-        ok = cholmod_factorize(E, s->Lc, cm) && cm->status >= CHOLMOD_OK;
-    int notpd = cm->status == CHOLMOD_NOT_POSDEF;
-    cm->supernodal = sn;
-    cm->nmethods = nm;
-    cm->method[0].ordering = ord;
-    cholmod_free_sparse(&E, cm);
-    if (!ok || notpd) {
-        if (notpd)
-            rc = mps_err_set(err, MPS_ESOLVE,
-                             "pcg_defl: the coarse matrix Z^T A Z (%d aggregates) is not positive "
-                             "definite: A is not, or an aggregate has no row",
-                             m);
-        else
-            rc = cholmod_fail(s, !s->Lc ? "cholmod_analyze" : "cholmod_factorize", err);
-        cholmod_free_factor(&s->Lc, cm);
-        return rc;
-    }
-    s->coarse_n = m;
-    return MPS_OK;
-}
-
-/* mu = E^-1 (Z^T v) (with_az = 0) or E^-1 ((A Z)^T v) (with_az = 1), into
- * s->Xc. Each thread sums its block of rows into its own m-vector. */
-static enum mps_status defl_coarse(struct fluid_linsolve *s, const struct fluid_csr *A,
-                                   const double *v, int with_az, const double **mu,
-                                   struct mps_err *err)
-{
-    const int n = A->n, m = s->nagg, *agg = s->agg;
-    double *rhs = s->cpart + (size_t)s->nthreads * (size_t)m;
-    if (with_az) {
-#pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static)
-        for (int a = 0; a < m; a++) {
-            double sum = 0.0;
-            for (int k = s->ztptr[a]; k < s->ztptr[a + 1]; k++)
-                sum += s->ztval[k] * v[s->ztrow[k]];
-            rhs[a] = sum;
-        }
-    } else {
-        /* once per solve (and restart): serial */
-        memset(rhs, 0, (size_t)m * sizeof *rhs);
-        for (int i = 0; i < n; i++)
-            rhs[agg[i]] += v[i];
-    }
-    cholmod_dense B = {0};
-    B.nrow = B.nzmax = B.d = (size_t)m;
-    B.ncol = 1;
-    B.xtype = CHOLMOD_REAL;
-    B.dtype = CHOLMOD_DOUBLE;
-    B.x = rhs;
-    if (!cholmod_solve2(CHOLMOD_A, s->Lc, &B, NULL, &s->Xc, NULL, &s->Yc, &s->Ec, &s->cm) ||
-        s->cm.status < CHOLMOD_OK)
-        return cholmod_fail(s, "cholmod_solve2 (coarse)", err);
-    *mu = s->Xc->x;
-    return MPS_OK;
-}
-
-/* x += Z c, r -= A Z c with c = E^-1 Z^T r, so that Z^T r = 0; returns r.r
- * in *rr. */
-static enum mps_status defl_start(struct fluid_linsolve *s, const struct fluid_csr *A, double *x,
-                                  double *r, double *rr, struct mps_err *err)
-{
-    const double *c;
-    enum mps_status rc = defl_coarse(s, A, r, 0, &c, err);
-    if (rc)
-        return rc;
-    const int n = A->n, *agg = s->agg;
-    double sum = 0.0;
-#pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static) \
-    reduction(+ : sum)
-    for (int i = 0; i < n; i++) {
-        const int base = A->rowptr[i];
-        double azc = 0.0;
-        for (int q = 0; q < s->azlen[i]; q++)
-            azc += s->azval[base + q] * c[s->azcol[base + q]];
-        x[i] += c[agg[i]];
-        r[i] -= azc;
-        sum += r[i] * r[i];
-    }
-    *rr = sum;
-    return MPS_OK;
-}
-
-/* p -= Z E^-1 (A Z)^T z */
-static enum mps_status defl_project(struct fluid_linsolve *s, const struct fluid_csr *A,
-                                    const double *z, double *p, struct mps_err *err)
-{
-    const double *mu;
-    enum mps_status rc = defl_coarse(s, A, z, 1, &mu, err);
-    if (rc)
-        return rc;
-    const int n = A->n, *agg = s->agg;
-#pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static)
-    for (int i = 0; i < n; i++)
-        p[i] -= mu[agg[i]];
-    return MPS_OK;
-}
 
 static double precond(struct fluid_linsolve *s, int n, const double *r, double *z)
 {
@@ -1163,18 +859,18 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
     }
     if (uses_ic0(s) && (rc = ic0_setup(s, A, err)))
         return rc;
-    if (defl && (rc = defl_setup(s, A, err)))
+    if (defl && (rc = fluid_defl_setup(s->defl, A, err)))
         return rc;
     double t2 = omp_get_wtime();
     st->t_factor = t2 - t1;
 
     double rr = rb[0];
     int it = 0, converged = 0;
-    if (defl && (rc = defl_start(s, A, x, r, &rr, err)))
+    if (defl && (rc = fluid_defl_start(s->defl, A, x, r, &rr, err)))
         return rc;
     double rz = precond(s, n, r, z);
     memcpy(p, z, (size_t)n * sizeof *p);
-    if (defl && (rc = defl_project(s, A, z, p, err)))
+    if (defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
         return rc;
     while (it < s->max_iter) {
         double pq = k_spmv_dot(s, A, p, q);
@@ -1200,11 +896,11 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
                 converged = 1;
                 break;
             }
-            if (defl && (rc = defl_start(s, A, x, r, &rr, err)))
+            if (defl && (rc = fluid_defl_start(s->defl, A, x, r, &rr, err)))
                 return rc;
             rz = precond(s, n, r, z);
             memcpy(p, z, (size_t)n * sizeof *p);
-            if (defl && (rc = defl_project(s, A, z, p, err)))
+            if (defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
                 return rc;
             continue;
         }
@@ -1212,7 +908,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         double beta = rz_new / rz;
         rz = rz_new;
         k_direction(s, n, beta, z, p);
-        if (defl && (rc = defl_project(s, A, z, p, err)))
+        if (defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
             return rc;
     }
     st->iterations = it;
@@ -1246,14 +942,14 @@ static void remember_analysis(struct fluid_linsolve *s, const struct fluid_csr *
     int fail = 0;
     s->perm_n = -1;
     if (n + 1 > s->cap_perm) {
-        s->perm = grow(s->perm, n + n / 8 + 1, sizeof *s->perm, &fail);
-        s->pat_ptr = grow(s->pat_ptr, n + n / 8 + 1, sizeof *s->pat_ptr, &fail);
+        s->perm = mps_realloc_or_flag(s->perm, n + n / 8 + 1, sizeof *s->perm, &fail);
+        s->pat_ptr = mps_realloc_or_flag(s->pat_ptr, n + n / 8 + 1, sizeof *s->pat_ptr, &fail);
         if (fail)
             return;
         s->cap_perm = n + n / 8 + 1;
     }
     if (nnz > s->cap_pat) {
-        s->pat_col = grow(s->pat_col, nnz + nnz / 8, sizeof *s->pat_col, &fail);
+        s->pat_col = mps_realloc_or_flag(s->pat_col, nnz + nnz / 8, sizeof *s->pat_col, &fail);
         if (fail)
             return;
         s->cap_pat = nnz + nnz / 8;
