@@ -12,6 +12,7 @@ import argparse, json, os, subprocess, sys, tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
+from bench_doc import write_keeping_notes  # noqa: E402
 from dambreak_compare import compare  # noqa: E402
 
 
@@ -63,14 +64,7 @@ def main():
             print(lines[-1], flush=True)
     lines.append('')
     # the hand-written reading (from "Command per row" on) is kept
-    if os.path.exists(a.out):
-        with open(a.out) as f:
-            old = f.read()
-        k = old.find('Command per row')
-        if k >= 0:
-            lines += [old[k:].rstrip('\n'), '']
-    with open(a.out, 'w') as f:
-        f.write('\n'.join(lines))
+    write_keeping_notes(a.out, lines, 'Command per row')
 
 
 if __name__ == '__main__':

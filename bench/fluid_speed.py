@@ -8,9 +8,11 @@ per thread count, and tabulates ns per particle-step by phase from each run's
 summary.json. Also times the paper's coarsest dam break (dp = 3 mm, 4,656
 fluid particles) over 1 s of simulated time, with the case's time step and
 with the solver's defaults. Run it on a quiet machine."""
-import argparse, json, os, subprocess, tempfile
+import argparse, json, os, subprocess, sys, tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, 'bench'))
+from bench_doc import write_keeping_notes  # noqa: E402
 
 
 def run(binary, dp, end, threads, extra=()):
@@ -88,15 +90,7 @@ def main():
     lines += ['', 'Commands (case, then defaults, on the last thread count): ' +
               '; '.join(f'`{c}`' for c in (cmds[-2], cmds[-1])), '']
     # the hand-written reading of the figures (from "## Reading it" on) is kept
-    if os.path.exists(args.out):
-        with open(args.out) as f:
-            old = f.read()
-        k = old.find('## Reading it')
-        if k >= 0:
-            lines += [old[k:].rstrip('\n'), '']
-    os.makedirs(os.path.dirname(args.out), exist_ok=True)
-    with open(args.out, 'w') as f:
-        f.write('\n'.join(lines))
+    lines = write_keeping_notes(args.out, lines, '## Reading it')
     print('\n'.join(lines))
 
 

@@ -33,8 +33,8 @@ struct fluid_defl {
     int *ztptr, *ztrow;  /* (A Z)^T in CSR: for each aggregate, the rows that touch it */
     double *ztval;
     size_t cap_ztptr, cap_zt;
-    size_t cap_az, cap_azlen, cap_cpart, cap_amark;
-    double *cpart;       /* coarse right-hand side (after nthreads slots) */
+    size_t cap_az, cap_azlen, cap_crhs, cap_amark;
+    double *crhs;        /* coarse right-hand side, m */
     cholmod_common cm;
     cholmod_factor *Lc;
     cholmod_dense *Xc, *Yc, *Ec;
@@ -93,7 +93,7 @@ void fluid_defl_destroy(struct fluid_defl **d)
     free(s->azlen);
     free(s->azcol);
     free(s->azval);
-    free(s->cpart);
+    free(s->crhs);
     free(s->amark);
     free(s->ztptr);
     free(s->ztrow);
@@ -161,7 +161,7 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
     if (rc)
         return rc;
     const int m = s->nagg, *agg = s->agg;
-    const size_t nnz = (size_t)A->rowptr[n], cp = ((size_t)s->nthreads + 1) * (size_t)m;
+    const size_t nnz = (size_t)A->rowptr[n], nmark = 2 * (size_t)s->nthreads * (size_t)m;
     int fail = 0;
     if ((size_t)n > s->cap_azlen) {
         s->azlen = mps_realloc_or_flag(s->azlen, (size_t)n + (size_t)n / 8 + 1,
@@ -175,15 +175,15 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
         if (!fail)
             s->cap_az = nnz + nnz / 8 + 1;
     }
-    if (cp > s->cap_cpart) {
-        s->cpart = mps_realloc_or_flag(s->cpart, cp, sizeof *s->cpart, &fail);
+    if ((size_t)m > s->cap_crhs) {
+        s->crhs = mps_realloc_or_flag(s->crhs, (size_t)m, sizeof *s->crhs, &fail);
         if (!fail)
-            s->cap_cpart = cp;
+            s->cap_crhs = (size_t)m;
     }
-    if (2 * cp > s->cap_amark) {
-        s->amark = mps_realloc_or_flag(s->amark, 2 * cp, sizeof *s->amark, &fail);
+    if (nmark > s->cap_amark) {
+        s->amark = mps_realloc_or_flag(s->amark, nmark, sizeof *s->amark, &fail);
         if (!fail)
-            s->cap_amark = 2 * cp;
+            s->cap_amark = nmark;
     }
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate the coarse space (%d rows, "
@@ -299,13 +299,14 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
 }
 
 /* mu = E^-1 (Z^T v) (with_az = 0) or E^-1 ((A Z)^T v) (with_az = 1), into
- * s->Xc. Each thread sums its block of rows into its own m-vector. */
+ * s->Xc. The second, once per iteration, gathers per aggregate over (A Z)^T
+ * in parallel. */
 static enum mps_status defl_coarse(struct fluid_defl *s, const struct fluid_csr *A,
                                    const double *v, int with_az, const double **mu,
                                    struct mps_err *err)
 {
     const int n = A->n, m = s->nagg, *agg = s->agg;
-    double *rhs = s->cpart + (size_t)s->nthreads * (size_t)m;
+    double *rhs = s->crhs;
     if (with_az) {
 #pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static)
         for (int a = 0; a < m; a++) {

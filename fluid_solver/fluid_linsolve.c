@@ -22,9 +22,9 @@ static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "
 
 /* "auto" = pcg_defl since 2026-11-22: with the fluid's aggregates (cells of
  * 4 spacings) its iterations stay at 11-12 per step from 6k to 80k
- * particles on the dam break, where pcg_sic0's grow 29 -> 53 -> 89, and the
- * PPE solve costs 214 / 679 ns per particle-step at 6k / 80k against 443 /
- * 2166 (2 threads, docs/ppe_solvers.md). Without aggregates it deflates
+ * particles on the dam break, where pcg_sic0's grow 29 -> 51 -> 78, and the
+ * PPE solve costs 216 / 671 ns per particle-step at 6k / 80k against 357 /
+ * 1807 (2 threads, Courant 0.4, docs/ppe_solvers.md). Without aggregates it deflates
  * blocks of consecutive rows, still a valid (weaker) preconditioner.
  * Before: pcg_sic0, since the real PPE of the 3 mm dam break was measured
  * (docs/ppe_solvers.md): the same iterations' worth of accuracy for 19% less
@@ -806,10 +806,24 @@ static double ic0_apply(struct fluid_linsolve *s, int n, const double *r, double
     return gather(s, nblk, 0);
 }
 
-
 static double precond(struct fluid_linsolve *s, int n, const double *r, double *z)
 {
     return uses_ic0(s) ? ic0_apply(s, n, r, z) : k_jacobi(s, n, r, z);
+}
+
+/* (Re)starts CG from the residual s->r of x: with deflation first moves x
+ * so that Z^T r = 0 (updating *rr = r.r), then z = M^-1 r, p = z (projected
+ * with deflation); r.z in *rz. */
+static enum mps_status first_direction(struct fluid_linsolve *s, const struct fluid_csr *A,
+                                       double *x, double *rr, double *rz, struct mps_err *err)
+{
+    const int n = A->n;
+    enum mps_status rc;
+    if (s->defl && (rc = fluid_defl_start(s->defl, A, x, s->r, rr, err)))
+        return rc;
+    *rz = precond(s, n, s->r, s->z);
+    memcpy(s->p, s->z, (size_t)n * sizeof *s->p);
+    return s->defl ? fluid_defl_project(s->defl, A, s->z, s->p, err) : MPS_OK;
 }
 
 static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, const double *b,
@@ -822,8 +836,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         return rc;
 
     double *r = s->r, *z = s->z, *p = s->p, *q = s->q;
-    const int defl = s->method == M_PCG_DEFL;
-    const double *dinv = s->method == M_PCG_JACOBI || defl ? s->dinv : NULL;
+    const double *dinv = s->method == M_PCG_JACOBI || s->defl ? s->dinv : NULL;
     double t0 = omp_get_wtime(), rb[2];
     k_residual(s, s->nthreads, A, b, x, r, rb);
     if (!isfinite(rb[0]) || !isfinite(rb[1])) {
@@ -859,18 +872,14 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
     }
     if (uses_ic0(s) && (rc = ic0_setup(s, A, err)))
         return rc;
-    if (defl && (rc = fluid_defl_setup(s->defl, A, err)))
+    if (s->defl && (rc = fluid_defl_setup(s->defl, A, err)))
         return rc;
     double t2 = omp_get_wtime();
     st->t_factor = t2 - t1;
 
-    double rr = rb[0];
+    double rr = rb[0], rz;
     int it = 0, converged = 0;
-    if (defl && (rc = fluid_defl_start(s->defl, A, x, r, &rr, err)))
-        return rc;
-    double rz = precond(s, n, r, z);
-    memcpy(p, z, (size_t)n * sizeof *p);
-    if (defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
+    if ((rc = first_direction(s, A, x, &rr, &rz, err)))
         return rc;
     while (it < s->max_iter) {
         double pq = k_spmv_dot(s, A, p, q);
@@ -896,11 +905,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
                 converged = 1;
                 break;
             }
-            if (defl && (rc = fluid_defl_start(s->defl, A, x, r, &rr, err)))
-                return rc;
-            rz = precond(s, n, r, z);
-            memcpy(p, z, (size_t)n * sizeof *p);
-            if (defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
+            if ((rc = first_direction(s, A, x, &rr, &rz, err)))
                 return rc;
             continue;
         }
@@ -908,7 +913,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         double beta = rz_new / rz;
         rz = rz_new;
         k_direction(s, n, beta, z, p);
-        if (defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
+        if (s->defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
             return rc;
     }
     st->iterations = it;

@@ -33,9 +33,8 @@ struct fluid_linsolve;
 /* method: "pcg_jacobi", "pcg_ic0", "pcg_sic0" (IC(0) of a sparsified
  * matrix, see fluid_linsolve_set_drop), "pcg_defl" (Jacobi PCG deflated by
  * aggregates of rows, see fluid_linsolve_set_aggregates), "cholmod",
- * "cholmod_reuse" (keeps the
- * fill-reducing ordering while the matrix size and pattern allow), "auto"
- * (the measured default). rtol: relative residual for iterative methods.
+ * "cholmod_reuse" (keeps the fill-reducing ordering while the matrix size
+ * and pattern allow), "auto" (the measured default). rtol: relative residual for iterative methods.
  * max_iter: iteration cap (an iterative solve that hits it fails with
  * MPS_ESOLVE naming the residual reached). */
 enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *method,

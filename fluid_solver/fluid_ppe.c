@@ -201,8 +201,8 @@ static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err
     const int direct = nxd * nyd <= 16.0 * (double)nr + 65536.0;
     const size_t ncell = direct ? (size_t)nxd * (size_t)nyd : 0, nx = (size_t)nxd;
     if (grow((void **)&f->agg, &f->cap_agg, nr + 1, sizeof *f->agg) ||
-        grow((void **)&f->aggkey, &f->cap_aggkey, 2 * nr + 2, sizeof *f->aggkey) ||
-        (direct && grow((void **)&f->aggmap, &f->cap_aggmap, ncell + 1, sizeof *f->aggmap)))
+        (direct && grow((void **)&f->aggmap, &f->cap_aggmap, ncell + 1, sizeof *f->aggmap)) ||
+        (!direct && grow((void **)&f->aggkey, &f->cap_aggkey, 2 * nr + 2, sizeof *f->aggkey)))
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for the coarse space");
     int m = 0;
     if (direct) {
