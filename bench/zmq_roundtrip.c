@@ -4,9 +4,11 @@
  * coupler-solid), so twice this is the least messaging a step can cost.
  *
  *   cc -O2 bench/zmq_roundtrip.c -o /tmp/zmq_roundtrip -lzmq
- *   /tmp/zmq_roundtrip [ROUND_TRIPS] [BYTES] [ENDPOINT]
+ *   /tmp/zmq_roundtrip [ROUND_TRIPS] [BYTES] [ENDPOINT] [FRAMES]
  *
- * defaults: 5000 round trips of 2000 bytes over ipc:///tmp/zmq_roundtrip.sock.
+ * defaults: 5000 round trips of 2000 bytes over ipc:///tmp/zmq_roundtrip.sock,
+ * one frame per message (FRAMES > 1 splits each message into that many
+ * parts, as the coupling protocol's messages are).
  * The receiver blocks in zmq_poll as the solvers do. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -22,13 +24,28 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
-/* Waits up to 5 s for one message; returns 0 on success. */
+/* Waits up to 5 s for one message, all its parts; returns 0 on success. */
 static int recv_one(void *s, char *buf, size_t size)
 {
     zmq_pollitem_t item = {s, 0, ZMQ_POLLIN, 0};
     if (zmq_poll(&item, 1, 5000) != 1)
         return -1;
-    return zmq_recv(s, buf, size, 0) < 0 ? -1 : 0;
+    int more = 1;
+    while (more) {
+        size_t len = sizeof more;
+        if (zmq_recv(s, buf, size, 0) < 0 || zmq_getsockopt(s, ZMQ_RCVMORE, &more, &len) != 0)
+            return -1;
+    }
+    return 0;
+}
+
+/* Sends size bytes as frames parts; returns 0 on success. */
+static int send_one(void *s, const char *buf, size_t size, int frames)
+{
+    for (int k = 0; k < frames; k++)
+        if (zmq_send(s, buf, size / (size_t)frames, k + 1 < frames ? ZMQ_SNDMORE : 0) < 0)
+            return -1;
+    return 0;
 }
 
 int main(int argc, char **argv)
@@ -36,8 +53,10 @@ int main(int argc, char **argv)
     int n = argc > 1 ? atoi(argv[1]) : 5000;
     size_t size = argc > 2 ? (size_t)atol(argv[2]) : 2000;
     const char *endpoint = argc > 3 ? argv[3] : "ipc:///tmp/zmq_roundtrip.sock";
-    if (n < 2 || size == 0) {
-        fprintf(stderr, "usage: %s [ROUND_TRIPS >= 2] [BYTES > 0] [ENDPOINT]\n", argv[0]);
+    int frames = argc > 4 ? atoi(argv[4]) : 1;
+    if (n < 2 || size == 0 || frames < 1 || (size_t)frames > size) {
+        fprintf(stderr, "usage: %s [ROUND_TRIPS >= 2] [BYTES > 0] [ENDPOINT] [FRAMES, 1..BYTES]\n",
+                argv[0]);
         return 2;
     }
     char *buf = calloc(size, 1);
@@ -56,7 +75,7 @@ int main(int argc, char **argv)
         if (zmq_connect(s, endpoint) != 0)
             return 1;
         for (int i = 0; i < n; i++)
-            if (recv_one(s, buf, size) || zmq_send(s, buf, size, 0) < 0)
+            if (recv_one(s, buf, size) || send_one(s, buf, size, frames))
                 return 1;
     } else {
         if (zmq_bind(s, endpoint) != 0) {
@@ -67,13 +86,13 @@ int main(int argc, char **argv)
         for (int i = 0; i < n; i++) {
             if (i == 1)
                 t0 = now(); /* the first trip includes the connection */
-            if (zmq_send(s, buf, size, 0) < 0 || recv_one(s, buf, size)) {
+            if (send_one(s, buf, size, frames) || recv_one(s, buf, size)) {
                 fprintf(stderr, "round trip %d failed\n", i);
                 return 1;
             }
         }
-        printf("%d round trips of %zu bytes over %s: %.1f us each\n", n - 1, size, endpoint,
-               1e6 * (now() - t0) / (n - 1));
+        printf("%d round trips of %zu bytes in %d frame(s) over %s: %.1f us each\n", n - 1,
+               size, frames, endpoint, 1e6 * (now() - t0) / (n - 1));
         int status = 0;
         waitpid(pid, &status, 0);
     }
