@@ -20,20 +20,20 @@
 
 struct fluid_defl {
     int nthreads, par_min_rows;
-    /* aggregates (borrowed from the caller until the next solve), A Z
-     * stored in A's row slots (azlen entries from rowptr[i]), (A Z)^T by
-     * aggregate, the factor of E, per-thread work */
+    /* aggregates (borrowed from the caller until the next solve), their
+     * rows, (A Z)^T by aggregate, the factor of E, per-thread work */
     const int *agg;
     int nagg, agg_n;     /* agg_n: rows the aggregates were given for */
     int *own_agg;        /* fallback: blocks of consecutive rows */
     size_t cap_own;
-    int *azlen, *azcol;
-    double *azval;
-    int *amark;          /* per thread, per aggregate: last row seen and its slot */
-    int *ztptr, *ztrow;  /* (A Z)^T in CSR: for each aggregate, the rows that touch it */
+    int *mptr, *mrow;    /* rows of aggregate a: mrow[mptr[a] .. mptr[a + 1]) */
+    /* (A Z)^T: aggregate a's ztlen[a] entries from ztptr[a], where ztptr
+     * bounds them by the nonzeros of a's rows (no count pass needed) */
+    int *ztptr, *ztlen, *ztrow;
     double *ztval;
-    size_t cap_ztptr, cap_zt;
-    size_t cap_az, cap_azlen, cap_crhs, cap_amark;
+    int *ecount;         /* entries of E's column a (upper triangle) */
+    int *mark;           /* per thread: row stamp and slot (2n), aggregate stamp and slot (2m) */
+    size_t cap_m, cap_mrow, cap_zt, cap_mark;
     double *crhs;        /* coarse right-hand side, m */
     cholmod_common cm;
     cholmod_factor *Lc;
@@ -90,14 +90,15 @@ void fluid_defl_destroy(struct fluid_defl **d)
     cholmod_free_dense(&s->Yc, &s->cm);
     cholmod_free_dense(&s->Ec, &s->cm);
     cholmod_finish(&s->cm);
-    free(s->azlen);
-    free(s->azcol);
-    free(s->azval);
-    free(s->crhs);
-    free(s->amark);
+    free(s->mptr);
+    free(s->mrow);
     free(s->ztptr);
+    free(s->ztlen);
     free(s->ztrow);
     free(s->ztval);
+    free(s->ecount);
+    free(s->mark);
+    free(s->crhs);
     free(s->own_agg);
     free(s);
     *d = NULL;
@@ -151,8 +152,97 @@ static enum mps_status defl_aggregates(struct fluid_defl *s, int n, struct mps_e
     return MPS_OK;
 }
 
-/* A Z (row i's distinct aggregates and the sums of its entries in each,
- * stored from rowptr[i]), E = Z^T A Z (upper triangle) and its factor. */
+/* Adds v to entry `key` of the list being accumulated at keys/vals[0 ..
+ * *len): stamp[key] == tag marks a key already in the list, at slot[key].
+ * Without a data-dependent branch (whether a key is new follows no pattern
+ * a predictor can learn): a key that is not new still writes itself and a
+ * zero into the first free slot, which the next new key overwrites, so the
+ * list needs room for one entry per call. */
+static inline void accumulate(int key, double v, int tag, int *stamp, int *slot, int *keys,
+                              double *vals, int *len)
+{
+    const int fresh = stamp[key] != tag, at = fresh ? *len : slot[key];
+    stamp[key] = tag;
+    slot[key] = at;
+    keys[*len] = key;
+    vals[*len] = 0.0;
+    vals[at] += v;
+    *len += fresh;
+}
+
+/* Sorts keys (and their values) by key: E's columns are a few tens long. */
+static void sort_column(int *keys, double *vals, int len)
+{
+    for (int q = 1; q < len; q++) {
+        int k = keys[q];
+        double v = vals[q];
+        int t = q - 1;
+        for (; t >= 0 && keys[t] > k; t--) {
+            keys[t + 1] = keys[t];
+            vals[t + 1] = vals[t];
+        }
+        keys[t + 1] = k;
+        vals[t + 1] = v;
+    }
+}
+
+/* E's upper triangle in CHOLMOD's CSC from (A Z)^T: column a holds, for each
+ * aggregate b <= a, E_ba = sum over the entries of (A Z)^T row a whose row
+ * lies in b. */
+static cholmod_sparse *coarse_matrix(struct fluid_defl *s, int n, struct mps_err *err,
+                                     enum mps_status *rc)
+{
+    const int m = s->nagg, *agg = s->agg;
+    int *ep = NULL;
+    size_t nz = 0;
+    for (int a = 0; a < m; a++)
+        nz += (size_t)s->ecount[a];
+    cholmod_sparse *E = cholmod_allocate_sparse((size_t)m, (size_t)m, nz, 1, 1, 1, CHOLMOD_REAL,
+                                                &s->cm);
+    if (!E) {
+        *rc = coarse_fail(s, "cholmod_allocate_sparse", err);
+        return NULL;
+    }
+    ep = E->p;
+    ep[0] = 0;
+    for (int a = 0; a < m; a++)
+        ep[a + 1] = ep[a] + s->ecount[a];
+    int *ei = E->i;
+    double *ex = E->x;
+#pragma omp parallel num_threads(s->nthreads) if (n >= s->par_min_rows)
+    {
+        int *stamp = s->mark + (size_t)omp_get_thread_num() * (2 * (size_t)n + 2 * (size_t)m) +
+                     2 * (size_t)n,
+            *slot = stamp + m;
+        for (int b = 0; b < m; b++)
+            stamp[b] = -1;
+#pragma omp for schedule(dynamic, 16)
+        for (int a = 0; a < m; a++) {
+            int len = 0;
+            /* branches here: the column has exactly ecount[a] slots */
+            int *rows = ei + ep[a];
+            double *vals = ex + ep[a];
+            for (int k = s->ztptr[a]; k < s->ztptr[a] + s->ztlen[a]; k++) {
+                int b = agg[s->ztrow[k]];
+                if (b > a)
+                    continue;
+                if (stamp[b] != a) {
+                    stamp[b] = a;
+                    slot[b] = len;
+                    rows[len] = b;
+                    vals[len++] = 0.0;
+                }
+                vals[slot[b]] += s->ztval[k];
+            }
+            sort_column(rows, vals, len);
+        }
+    }
+    return E;
+}
+
+/* (A Z)^T and E = Z^T A Z (upper triangle) and its factor. Row a of
+ * (A Z)^T = Z^T A is the sum of A's rows in aggregate a (A is symmetric),
+ * so both are built per aggregate, in parallel and without a transpose. */
 enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A,
                                  struct mps_err *err)
 {
@@ -161,121 +251,94 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
     if (rc)
         return rc;
     const int m = s->nagg, *agg = s->agg;
-    const size_t nnz = (size_t)A->rowptr[n], nmark = 2 * (size_t)s->nthreads * (size_t)m;
+    const size_t nnz = (size_t)A->rowptr[n];
+    const size_t mark_need = (size_t)s->nthreads * (2 * (size_t)n + 2 * (size_t)m);
     int fail = 0;
-    if ((size_t)n > s->cap_azlen) {
-        s->azlen = mps_realloc_or_flag(s->azlen, (size_t)n + (size_t)n / 8 + 1,
-                                       sizeof *s->azlen, &fail);
+    if ((size_t)m + 1 > s->cap_m) {
+        size_t c = (size_t)m + (size_t)m / 8 + 2;
+        s->mptr = mps_realloc_or_flag(s->mptr, c, sizeof *s->mptr, &fail);
+        s->ztptr = mps_realloc_or_flag(s->ztptr, c, sizeof *s->ztptr, &fail);
+        s->ztlen = mps_realloc_or_flag(s->ztlen, c, sizeof *s->ztlen, &fail);
+        s->ecount = mps_realloc_or_flag(s->ecount, c, sizeof *s->ecount, &fail);
+        s->crhs = mps_realloc_or_flag(s->crhs, c, sizeof *s->crhs, &fail);
         if (!fail)
-            s->cap_azlen = (size_t)n + (size_t)n / 8 + 1;
+            s->cap_m = c;
     }
-    if (nnz > s->cap_az) {
-        s->azcol = mps_realloc_or_flag(s->azcol, nnz + nnz / 8 + 1, sizeof *s->azcol, &fail);
-        s->azval = mps_realloc_or_flag(s->azval, nnz + nnz / 8 + 1, sizeof *s->azval, &fail);
+    if ((size_t)n + 1 > s->cap_mrow) {
+        size_t c = (size_t)n + (size_t)n / 8 + 1;
+        s->mrow = mps_realloc_or_flag(s->mrow, c, sizeof *s->mrow, &fail);
         if (!fail)
-            s->cap_az = nnz + nnz / 8 + 1;
+            s->cap_mrow = c;
     }
-    if ((size_t)m > s->cap_crhs) {
-        s->crhs = mps_realloc_or_flag(s->crhs, (size_t)m, sizeof *s->crhs, &fail);
-        if (!fail)
-            s->cap_crhs = (size_t)m;
-    }
-    if (nmark > s->cap_amark) {
-        s->amark = mps_realloc_or_flag(s->amark, nmark, sizeof *s->amark, &fail);
-        if (!fail)
-            s->cap_amark = nmark;
-    }
-    if (fail)
-        return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate the coarse space (%d rows, "
-                                            "%d aggregates)", n, m);
-    int *azlen = s->azlen, *azcol = s->azcol;
-    double *azval = s->azval;
-    long long total = 0;
-#pragma omp parallel num_threads(s->nthreads) if (n >= s->par_min_rows) reduction(+ : total)
-    {
-        /* seen[a] = the last row that met aggregate a, slot[a] its place
-         * in that row: one lookup per entry instead of a search */
-        int *seen = s->amark + 2 * (size_t)omp_get_thread_num() * (size_t)m, *slot = seen + m;
-        for (int a = 0; a < m; a++)
-            seen[a] = -1;
-#pragma omp for schedule(static)
-        for (int i = 0; i < n; i++) {
-            const int base = A->rowptr[i];
-            int len = 0;
-            for (int k = base; k < A->rowptr[i + 1]; k++) {
-                int a = agg[A->col[k]];
-                if (seen[a] != i) {
-                    seen[a] = i;
-                    slot[a] = base + len;
-                    azcol[base + len] = a;
-                    azval[base + len++] = 0.0;
-                }
-                azval[slot[a]] += A->val[k];
-            }
-            azlen[i] = len;
-            total += len;
-        }
-    }
-
-    /* (A Z)^T by rows: the projection's restriction then gathers per
-     * aggregate instead of scattering per row (consecutive rows mostly hit
-     * the same aggregate, and a scatter waits on its own last store) */
-    if ((size_t)m + 1 > s->cap_ztptr) {
-        s->ztptr = mps_realloc_or_flag(s->ztptr, (size_t)m + 1, sizeof *s->ztptr, &fail);
-        if (!fail)
-            s->cap_ztptr = (size_t)m + 1;
-    }
-    if ((size_t)total + 1 > s->cap_zt) {
-        size_t c = (size_t)total + (size_t)total / 8 + 1;
+    if (nnz + 1 > s->cap_zt) {
+        size_t c = nnz + nnz / 8 + 1;
         s->ztrow = mps_realloc_or_flag(s->ztrow, c, sizeof *s->ztrow, &fail);
         s->ztval = mps_realloc_or_flag(s->ztval, c, sizeof *s->ztval, &fail);
         if (!fail)
             s->cap_zt = c;
     }
+    if (mark_need > s->cap_mark) {
+        s->mark = mps_realloc_or_flag(s->mark, mark_need, sizeof *s->mark, &fail);
+        if (!fail)
+            s->cap_mark = mark_need;
+    }
     if (fail)
-        return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate (A Z)^T (%lld entries)",
-                           total);
-    int *ztptr = s->ztptr;
+        return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate the coarse space (%d rows, "
+                                            "%d aggregates)", n, m);
+
+    /* rows by aggregate (a counting sort, in row order), and where each
+     * aggregate's (A Z)^T row may start: the nonzeros of its rows bound it */
+    int *mptr = s->mptr, *ztptr = s->ztptr;
+    memset(mptr, 0, ((size_t)m + 1) * sizeof *mptr);
     memset(ztptr, 0, ((size_t)m + 1) * sizeof *ztptr);
-    for (int i = 0; i < n; i++)
-        for (int q = 0; q < azlen[i]; q++)
-            ztptr[azcol[A->rowptr[i] + q] + 1]++;
-    for (int a = 0; a < m; a++)
-        ztptr[a + 1] += ztptr[a];
     for (int i = 0; i < n; i++) {
-        const int base = A->rowptr[i];
-        for (int q = 0; q < azlen[i]; q++) {
-            int at = ztptr[azcol[base + q]]++;
-            s->ztrow[at] = i;
-            s->ztval[at] = azval[base + q];
+        mptr[agg[i] + 1]++;
+        ztptr[agg[i] + 1] += A->rowptr[i + 1] - A->rowptr[i];
+    }
+    for (int a = 0; a < m; a++) {
+        mptr[a + 1] += mptr[a];
+        ztptr[a + 1] += ztptr[a];
+    }
+    for (int i = 0; i < n; i++)
+        s->mrow[mptr[agg[i]]++] = i;
+    for (int a = m; a > 0; a--)
+        mptr[a] = mptr[a - 1];
+    mptr[0] = 0;
+
+#pragma omp parallel num_threads(s->nthreads) if (n >= s->par_min_rows)
+    {
+        int *stamp = s->mark + (size_t)omp_get_thread_num() * (2 * (size_t)n + 2 * (size_t)m),
+            *slot = stamp + n, *astamp = stamp + 2 * (size_t)n;
+        for (int i = 0; i < n; i++)
+            stamp[i] = -1;
+        for (int b = 0; b < m; b++)
+            astamp[b] = -1;
+#pragma omp for schedule(dynamic, 16)
+        for (int a = 0; a < m; a++) {
+            int *rows = s->ztrow + ztptr[a];
+            double *vals = s->ztval + ztptr[a];
+            int len = 0;
+            for (int q = mptr[a]; q < mptr[a + 1]; q++) {
+                const int i = s->mrow[q];
+                for (int k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+                    accumulate(A->col[k], A->val[k], a, stamp, slot, rows, vals, &len);
+            }
+            s->ztlen[a] = len;
+            /* E's column a: the distinct aggregates b <= a among these rows */
+            int cnt = 0;
+            for (int q = 0; q < len; q++) {
+                int b = agg[rows[q]];
+                cnt += b <= a && astamp[b] != a;
+                astamp[b] = b <= a ? a : astamp[b];
+            }
+            s->ecount[a] = cnt;
         }
     }
-    for (int a = m; a > 0; a--)
-        ztptr[a] = ztptr[a - 1];
-    ztptr[0] = 0;
 
     cholmod_common *cm = &s->cm;
-    cholmod_triplet *T = cholmod_allocate_triplet((size_t)m, (size_t)m, (size_t)total, 1,
-                                                  CHOLMOD_REAL, cm);
-    if (!T)
-        return coarse_fail(s, "cholmod_allocate_triplet", err);
-    int *ti = T->i, *tj = T->j;
-    double *tx = T->x;
-    size_t t = 0;
-    for (int i = 0; i < n; i++) {
-        const int base = A->rowptr[i], ai = agg[i];
-        for (int q = 0; q < azlen[i]; q++)
-            if (ai <= azcol[base + q]) {   /* E is symmetric: its upper triangle */
-                ti[t] = ai;
-                tj[t] = azcol[base + q];
-                tx[t++] = azval[base + q];
-            }
-    }
-    T->nnz = t;
-    cholmod_sparse *E = cholmod_triplet_to_sparse(T, t, cm);
-    cholmod_free_triplet(&T, cm);
+    cholmod_sparse *E = coarse_matrix(s, n, err, &rc);
     if (!E)
-        return coarse_fail(s, "cholmod_triplet_to_sparse", err);
+        return rc;
     cholmod_free_factor(&s->Lc, cm);
     s->Lc = cholmod_analyze(E, cm);
     int ok = s->Lc && cm->status >= CHOLMOD_OK;
@@ -311,7 +374,7 @@ static enum mps_status defl_coarse(struct fluid_defl *s, const struct fluid_csr 
 #pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static)
         for (int a = 0; a < m; a++) {
             double sum = 0.0;
-            for (int k = s->ztptr[a]; k < s->ztptr[a + 1]; k++)
+            for (int k = s->ztptr[a]; k < s->ztptr[a] + s->ztlen[a]; k++)
                 sum += s->ztval[k] * v[s->ztrow[k]];
             rhs[a] = sum;
         }
@@ -348,10 +411,10 @@ enum mps_status fluid_defl_start(struct fluid_defl *s, const struct fluid_csr *A
 #pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static) \
     reduction(+ : sum)
     for (int i = 0; i < n; i++) {
-        const int base = A->rowptr[i];
+        /* (A Z c)_i = sum_j A_ij c_agg(j): a product with A, once per solve */
         double azc = 0.0;
-        for (int q = 0; q < s->azlen[i]; q++)
-            azc += s->azval[base + q] * c[s->azcol[base + q]];
+        for (int k = A->rowptr[i]; k < A->rowptr[i + 1]; k++)
+            azc += A->val[k] * c[agg[A->col[k]]];
         x[i] += c[agg[i]];
         r[i] -= azc;
         sum += r[i] * r[i];
