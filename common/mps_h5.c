@@ -471,50 +471,61 @@ enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, si
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 
     /* PREFIX_NNNNNN: NNNNNN counts snapshots (not steps), so names sort and
-     * ParaView groups them as one series. */
+     * ParaView groups them as one series. The file is written as
+     * NAME.h5.tmp and renamed once closed: a process killed while writing
+     * leaves a .tmp, never a truncated NAME.h5 that a script globbing *.h5
+     * would trip on. */
     size_t namelen = strlen(s->prefix) + 24;
-    char *name = malloc(namelen), *file = malloc(namelen), *path = NULL;
+    char *name = malloc(namelen), *file = malloc(namelen), *path = NULL, *tmp = NULL;
     if (name && file) {
         snprintf(name, namelen, "%s_%06d", s->prefix, s->count);
         snprintf(file, namelen, "%s.h5", name);
         path = join_path(s->dir, file, "");
+        tmp = path ? join_path(s->dir, file, ".tmp") : NULL;
     }
-    if (!path) {
+    if (!tmp) {
         free(name);
         free(file);
+        free(path);
         return mps_err_set(err, MPS_ENOMEM, "snapshot: out of memory");
     }
 
     hid_t fid = -1, grp = -1;
-    if ((fid = H5Fcreate(path, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
-        st = h5_fail(err, path, "H5Fcreate");
+    if ((fid = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
+        st = h5_fail(err, tmp, "H5Fcreate");
         goto done;
     }
     int64_t step64 = step;
-    if ((st = attr_num(fid, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, path, err)) ||
-        (st = attr_num(fid, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64, path, err)) ||
-        (st = attr_str(fid, "code_version", MPS_VERSION, path, err)) ||
-        (st = attr_str(fid, "git_rev", MPS_GIT_REV, path, err)) ||
-        (st = attr_str(fid, "solver", s->solver, path, err)) ||
-        (st = write_config(fid, s->config, path, err)))
+    if ((st = attr_num(fid, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, tmp, err)) ||
+        (st = attr_num(fid, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64, tmp, err)) ||
+        (st = attr_str(fid, "code_version", MPS_VERSION, tmp, err)) ||
+        (st = attr_str(fid, "git_rev", MPS_GIT_REV, tmp, err)) ||
+        (st = attr_str(fid, "solver", s->solver, tmp, err)) ||
+        (st = write_config(fid, s->config, tmp, err)))
         goto done;
     if ((grp = H5Gcreate2(fid, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
-        st = h5_fail(err, path, "H5Gcreate2(/particles)");
+        st = h5_fail(err, tmp, "H5Gcreate2(/particles)");
         goto done;
     }
-    if ((st = write_field(grp, "position", MPS_DIM, MPS_F64, n, x, "m", path, err)))
+    if ((st = write_field(grp, "position", MPS_DIM, MPS_F64, n, x, "m", tmp, err)))
         goto done;
     for (int k = 0; k < nfields; k++) {
         const struct mps_field *f = &fields[k];
-        if ((st = write_field(grp, f->name, f->ncomp, f->type, n, f->data, f->units, path, err)))
+        if ((st = write_field(grp, f->name, f->ncomp, f->type, n, f->data, f->units, tmp, err)))
             goto done;
     }
 done:
     if (grp >= 0 && H5Gclose(grp) < 0 && st == MPS_OK)
-        st = h5_fail(err, path, "H5Gclose");
+        st = h5_fail(err, tmp, "H5Gclose");
     /* The close flushes the data: its failure is a failed write. */
     if (fid >= 0 && H5Fclose(fid) < 0 && st == MPS_OK)
-        st = h5_fail(err, path, "H5Fclose");
+        st = h5_fail(err, tmp, "H5Fclose");
+    if (st == MPS_OK && rename(tmp, path) != 0)
+        st = mps_err_set(err, MPS_EIO, "cannot rename '%s' to '%s': %s", tmp, path,
+                         strerror(errno));
+    if (st != MPS_OK && fid >= 0)
+        remove(tmp);
+    free(tmp);
     free(path);
     /* Only a complete, closed file enters the index. */
     char *grid = st == MPS_OK ? xdmf_grid(name, file, time, n, fields, nfields) : NULL;

@@ -181,6 +181,8 @@ static void check_fluid(const char *dir)
 {
     for (int sn = 0; sn < 3; sn++) {
         char path[512];
+        snprintf(path, sizeof path, "%s/fluid_%06d.h5.tmp", dir, sn);
+        CHECK(access(path, F_OK) != 0); /* renamed once complete */
         snprintf(path, sizeof path, "%s/fluid_%06d.h5", dir, sn);
         hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
         CHECK(f >= 0);
@@ -368,18 +370,33 @@ static void check_errors(const char *dir)
     CHECK(mps_h5_open(&s, dir, "a/b", "x", "", &err) == MPS_EINPUT);
     CHECK(s == NULL);
 
-    /* A directory where the snapshot file should go makes H5Fcreate fail. */
-    char path[512];
+    /* A snapshot is written as NAME.h5.tmp, then renamed. A directory where
+     * the .tmp should go makes H5Fcreate fail. */
+    char path[512], tmp[520];
     snprintf(path, sizeof path, "%s/err_000000.h5", dir);
-    CHECK(mkdir(path, 0777) == 0);
+    snprintf(tmp, sizeof tmp, "%s.tmp", path);
+    CHECK(mkdir(tmp, 0777) == 0);
     CHECK(mps_h5_open(&s, dir, "err", "x", "", &err) == MPS_OK);
     double x[1][MPS_DIM] = {{0}};
     enum mps_status st = mps_h5_write(s, 0.0, 0, 1, (const double(*)[MPS_DIM])x, NULL, 0, &err);
     CHECK(st == MPS_ELIB);
-    CHECK(strstr(err.msg, "err_000000.h5") != NULL);
+    CHECK(strstr(err.msg, "err_000000.h5.tmp") != NULL);
     CHECK(strstr(err.msg, "H5Fcreate") != NULL);
     printf("expected error: %s\n", err.msg);
     CHECK(mps_h5_count(s) == 0);
+    CHECK(access(path, F_OK) != 0);
+    CHECK(rmdir(tmp) == 0);
+
+    /* A directory at the final name makes the rename fail: the complete
+     * .tmp is removed, nothing enters the index. */
+    CHECK(mkdir(path, 0777) == 0);
+    st = mps_h5_write(s, 0.0, 0, 1, (const double(*)[MPS_DIM])x, NULL, 0, &err);
+    CHECK(st == MPS_EIO);
+    CHECK(strstr(err.msg, "cannot rename") != NULL);
+    CHECK(strstr(err.msg, "err_000000.h5'") != NULL);
+    printf("expected error: %s\n", err.msg);
+    CHECK(mps_h5_count(s) == 0);
+    CHECK(access(tmp, F_OK) != 0);
 
     /* a field without data, a non-finite time */
     struct mps_field f = {"p", 1, MPS_F64, NULL, "Pa"};
