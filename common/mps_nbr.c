@@ -104,6 +104,27 @@ void mps_nbr_grid_free(struct mps_nbr_grid *g)
 }
 
 
+/* Room for npairs pairs in l: j, and r2 unless l->no_r2. */
+static int grow_pairs(struct mps_nbr_list *l, size_t npairs)
+{
+    size_t c1 = l->cap_pairs, c2 = l->cap_pairs;
+    if (grow((void **)&l->j, &c1, npairs + 1, sizeof(int)) ||
+        (!l->no_r2 && grow((void **)&l->r2, &c2, npairs + 1, sizeof(double))))
+        return -1;
+    l->cap_pairs = l->no_r2 ? c1 : (c1 < c2 ? c1 : c2);
+    return 0;
+}
+
+static inline double pair_r2(const double (*x)[MPS_DIM], size_t i, int j)
+{
+    double r2 = 0.0;
+    for (int d = 0; d < MPS_DIM; d++) {
+        double dx = x[j][d] - x[i][d];
+        r2 += dx * dx;
+    }
+    return r2;
+}
+
 /* The block of cells around particle i's cell that a query visits: columns
  * a0..a1 of rows b0..b1, clipped to the grid. */
 struct cell_window {
@@ -140,7 +161,7 @@ static size_t candidates(const struct mps_nbr_grid *g, const struct cell_window 
  * they are merged. */
 static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], size_t i,
                     const struct cell_window *w, double r2max, int *jout, double *r2out,
-                    int *jtmp, double *r2tmp)
+                    int *jtmp, double *r2tmp, const int want_r2)
 {
     const double xi = x[i][0], yi = x[i][1];
     size_t runs[3 * 3 + 1], nruns = 0, m = 0;
@@ -157,7 +178,8 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
                 /* written always, kept by advancing m: a third of the
                  * candidates pass, in no learnable order */
                 jtmp[m] = (int)j;
-                r2tmp[m] = r2;
+                if (want_r2)
+                    r2tmp[m] = r2;
                 m += (r2 < r2max) & (j != i);
             }
             if (m > runs[nruns])
@@ -173,22 +195,31 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
         for (size_t q = 0; q < nruns; q += 2) {
             size_t p1 = runs[q], e1 = runs[q + 1];
             size_t p2 = q + 1 < nruns ? runs[q + 1] : e1, e2 = q + 1 < nruns ? runs[q + 2] : e1;
-            while (p1 < e1 && p2 < e2) {
-                if (js[p1] < js[p2]) {
-                    jd[o] = js[p1];
-                    rd[o++] = rs[p1++];
-                } else {
-                    jd[o] = js[p2];
-                    rd[o++] = rs[p2++];
+            if (want_r2) {
+                while (p1 < e1 && p2 < e2) {
+                    if (js[p1] < js[p2]) {
+                        jd[o] = js[p1];
+                        rd[o++] = rs[p1++];
+                    } else {
+                        jd[o] = js[p2];
+                        rd[o++] = rs[p2++];
+                    }
                 }
-            }
-            for (; p1 < e1; p1++, o++) {
-                jd[o] = js[p1];
-                rd[o] = rs[p1];
-            }
-            for (; p2 < e2; p2++, o++) {
-                jd[o] = js[p2];
-                rd[o] = rs[p2];
+                for (; p1 < e1; p1++, o++) {
+                    jd[o] = js[p1];
+                    rd[o] = rs[p1];
+                }
+                for (; p2 < e2; p2++, o++) {
+                    jd[o] = js[p2];
+                    rd[o] = rs[p2];
+                }
+            } else {
+                while (p1 < e1 && p2 < e2)
+                    jd[o++] = js[p1] < js[p2] ? js[p1++] : js[p2++];
+                for (; p1 < e1; p1++, o++)
+                    jd[o] = js[p1];
+                for (; p2 < e2; p2++, o++)
+                    jd[o] = js[p2];
             }
             runs[++nr] = o;
         }
@@ -202,7 +233,8 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
     }
     if (js != jout) {
         memcpy(jout, js, m * sizeof *jout);
-        memcpy(r2out, rs, m * sizeof *r2out);
+        if (want_r2)
+            memcpy(r2out, rs, m * sizeof *r2out);
     }
     return m;
 }
@@ -233,6 +265,7 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
     if (grow((void **)&l->start, &l->cap_n, nquery + 1, sizeof(size_t)))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
     const double r2max = radius * radius;
+    const int want_r2 = !l->no_r2;
     l->n = nquery;
     l->radius = radius;
     l->start[0] = 0;
@@ -280,13 +313,16 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
                 struct cell_window w = cell_window(g, i);
                 size_t room = candidates(g, &w);
                 if (grow((void **)&sc->jb, &sc->cap, used + room + 1, sizeof *sc->jb) ||
-                    grow((void **)&sc->rb, &sc->cap2, used + room + 1, sizeof *sc->rb) ||
                     grow((void **)&sc->jt, &sc->capt, room + 1, sizeof *sc->jt) ||
-                    grow((void **)&sc->rt, &sc->capt2, room + 1, sizeof *sc->rt)) {
+                    (want_r2 &&
+                     (grow((void **)&sc->rb, &sc->cap2, used + room + 1, sizeof *sc->rb) ||
+                      grow((void **)&sc->rt, &sc->capt2, room + 1, sizeof *sc->rt)))) {
                     lfail = 1;
                     break;
                 }
-                m = visit(g, x, i, &w, r2max, sc->jb + used, sc->rb + used, sc->jt, sc->rt);
+                m = want_r2 ? visit(g, x, i, &w, r2max, sc->jb + used, sc->rb + used, sc->jt,
+                                    sc->rt, 1)
+                            : visit(g, x, i, &w, r2max, sc->jb + used, NULL, sc->jt, NULL, 0);
             }
             l->start[i + 1] = m;
             used += m;
@@ -301,16 +337,13 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
             for (size_t i = 0; i < nquery && !fail; i++)
                 l->start[i + 1] += l->start[i];
             npairs = fail ? 0 : l->start[nquery];
-            size_t c1 = l->cap_pairs, c2 = l->cap_pairs;
-            if (!fail && (grow((void **)&l->j, &c1, npairs + 1, sizeof(int)) ||
-                          grow((void **)&l->r2, &c2, npairs + 1, sizeof(double))))
+            if (!fail && grow_pairs(l, npairs))
                 fail = 2;
-            else if (!fail)
-                l->cap_pairs = c1 < c2 ? c1 : c2;
         }
         if (!fail && used > 0) {
             memcpy(l->j + l->start[lo], sc->jb, used * sizeof *sc->jb);
-            memcpy(l->r2 + l->start[lo], sc->rb, used * sizeof *sc->rb);
+            if (want_r2)
+                memcpy(l->r2 + l->start[lo], sc->rb, used * sizeof *sc->rb);
         }
     }
     free(bound);
@@ -331,39 +364,36 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
     dst->n = n;
     dst->radius = radius;
     dst->start[0] = 0;
+    const int src_r2 = !src->no_r2, dst_r2 = !dst->no_r2;
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++) {
         size_t m = 0;
         for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            int j = src->j[k];
-            double r2 = 0.0;
-            for (int d = 0; d < MPS_DIM; d++) {
-                double dx = x[j][d] - x[i][d];
-                r2 += dx * dx;
-            }
-            src->r2[k] = r2;
+            double r2 = pair_r2(x, i, src->j[k]);
+            if (src_r2)
+                src->r2[k] = r2;
             m += r2 < r2max;
         }
         dst->start[i + 1] = m;
     }
     for (size_t i = 0; i < n; i++)
         dst->start[i + 1] += dst->start[i];
-    size_t npairs = dst->start[n], cap = dst->cap_pairs, cap2 = dst->cap_pairs;
-    if (grow((void **)&dst->j, &cap, npairs + 1, sizeof(int)) ||
-        grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
+    size_t npairs = dst->start[n];
+    if (grow_pairs(dst, npairs))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
-    dst->cap_pairs = cap < cap2 ? cap : cap2;
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < n; i++) {
         /* Every candidate is written and kept by advancing m (which of
          * them pass has no order a branch predictor could learn); the
-         * m < end test fails only once the row is full. */
+         * m < end test fails only once the row is full. Without src's r2
+         * the distance is recomputed, the same arithmetic as above. */
         size_t m = dst->start[i], end = dst->start[i + 1];
         for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            double r2 = src->r2[k];
+            double r2 = src_r2 ? src->r2[k] : pair_r2(x, i, src->j[k]);
             if (m < end) {
                 dst->j[m] = src->j[k];
-                dst->r2[m] = r2;
+                if (dst_r2)
+                    dst->r2[m] = r2;
             }
             m += r2 < r2max;
         }
@@ -376,6 +406,10 @@ enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_
                                      struct mps_err *err)
 {
     const size_t n = src->n, m = to_hi > to_lo ? to_hi - to_lo : 0;
+    const int dst_r2 = !dst->no_r2;
+    if (dst_r2 && src->no_r2)
+        return mps_err_set(err, MPS_EINPUT,
+                           "neighbour list reverse: the source keeps no r2 for the destination");
     if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
     dst->n = n;
@@ -415,12 +449,8 @@ enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_
                     }
                 dst->start[j + 1] = at;
             }
-            size_t npairs = dst->start[n], cap = dst->cap_pairs, cap2 = dst->cap_pairs;
-            if (grow((void **)&dst->j, &cap, npairs + 1, sizeof(int)) ||
-                grow((void **)&dst->r2, &cap2, npairs + 1, sizeof(double)))
+            if (grow_pairs(dst, dst->start[n]))
                 fail = 1;
-            else
-                dst->cap_pairs = cap < cap2 ? cap : cap2;
         }
         if (!fail)
             for (size_t i = lo; i < hi; i++)
@@ -429,7 +459,8 @@ enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_
                     if (j >= to_lo && j < to_hi) {
                         size_t at = c[j - to_lo]++;
                         dst->j[at] = (int)i;
-                        dst->r2[at] = src->r2[k];
+                        if (dst_r2)
+                            dst->r2[at] = src->r2[k];
                     }
                 }
     }

@@ -28,7 +28,11 @@ struct mps_nbr_list {
     size_t n;             /* particles */
     size_t *start;        /* n + 1 offsets */
     int *j;               /* neighbour index */
-    double *r2;           /* squared distance */
+    double *r2;           /* squared distance (NULL with no_r2) */
+    /* Set before the first build to keep j only: a list whose users
+     * recompute distances at moved positions (a fluid's) then writes a
+     * third of the bytes. */
+    int no_r2;
     size_t cap_n, cap_pairs;
     double radius;
     /* per-thread buffers of the build, kept so a rebuild allocates nothing */
@@ -58,7 +62,8 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
                                           struct mps_err *err);
 /* The transpose of part of src: row j of dst (to_lo <= j < to_hi) lists the
  * i in [from_lo, from_hi) whose row of src holds j, sorted by i, with src's
- * r2; all other rows of dst are empty. dst has src->n rows. */
+ * r2 (unless dst->no_r2; a src without r2 needs a dst without); all other
+ * rows of dst are empty. dst has src->n rows. */
 enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
                                      size_t from_lo, size_t from_hi, size_t to_lo, size_t to_hi,
                                      struct mps_err *err);
@@ -66,9 +71,9 @@ void mps_nbr_list_free(struct mps_nbr_list *l);
 
 /* The pairs of src that are closer than radius at positions x (which may have
  * moved since src was built: r2 is recomputed), kept in src's order. Used to
- * derive a short-radius list from a long-radius list with a skin. src->r2 is
- * overwritten with the squared distances at x (the second pass reads them
- * instead of gathering x[j] again). */
+ * derive a short-radius list from a long-radius list with a skin. If src
+ * keeps r2 it is overwritten with the squared distances at x (the second
+ * pass reads them instead of gathering x[j] again). */
 enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_list *src,
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err);

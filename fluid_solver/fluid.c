@@ -41,6 +41,7 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "ncount", 1, MPS_I32, (void **)&f->ncount, "", 0);
     mps_particles_add_field(ps, "row", 1, MPS_I32, (void **)&f->row, "", 0);
     mps_particles_add_field(ps, "ppe_nbrs", 1, MPS_I32, (void **)&f->nwlap, "", 0);
+    mps_particles_add_field(ps, "ppe_flags", 1, MPS_U8, (void **)&f->ppe_flag, "", 0);
     mps_particles_add_field(ps, "has_p", 1, MPS_U8, (void **)&f->has_p, "", 0);
     mps_particles_add_field(ps, "is_fluid", 1, MPS_U8, (void **)&f->is_fluid, "", 0);
     mps_particles_add_field(ps, "nbr_query", 1, MPS_U8, (void **)&f->nbr_query, "", 0);
@@ -112,6 +113,9 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
         return mps_err_set(err, MPS_ENOMEM, "fluid: out of memory");
     f->prm = *prm;
     register_fields(f);
+    /* every user of the fluid's lists recomputes distances at the positions
+     * of the moment: the lists keep indices only */
+    f->nl.no_r2 = f->nl_n.no_r2 = f->nl_tank.no_r2 = 1;
     mps_timer_init(&f->timer, phase_names, PH_COUNT);
 
     struct fluid_scene_pt *pts = NULL;

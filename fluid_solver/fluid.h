@@ -47,6 +47,8 @@ struct fluid {
     int *type;             /* enum fluid_ptype */
     int *id;               /* stable id (solid particles: the solid's id) */
     int *row;              /* PPE row, -1 if not an unknown */
+    unsigned char *ppe_flag; /* the masks PPE pass 1 reads of a neighbour, in one byte
+                              * (fluid_ppe.c, PPE_F_*), set at each assembly */
     unsigned char *surface; /* free surface (P = 0) */
     unsigned char *has_p;   /* carries a pressure: fluid, wall, solid surface */
     unsigned char *is_fluid;

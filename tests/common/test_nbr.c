@@ -274,10 +274,67 @@ static void test_kernel(void)
     CHECK(same);
 }
 
+/* Lists that keep only j (no_r2, as the fluid's): the same pairs in the same
+ * order as lists with r2, through the build, the filter at moved positions
+ * and the reverse; a reverse that would need r2 from such a list is an
+ * error. */
+static void test_no_r2(void)
+{
+    const size_t n = 1500, nf = 900;
+    const double l0 = 0.01, re = 5.0 * l0, rs = 2.1 * l0;
+    double (*x)[MPS_DIM] = malloc(n * sizeof *x);
+    unsigned long long seed = 4242;
+    for (size_t i = 0; i < n; i++) {
+        x[i][0] = 40 * l0 * urand(&seed);
+        x[i][1] = 40 * l0 * urand(&seed);
+    }
+    const double (*cx)[MPS_DIM] = (const double(*)[MPS_DIM])x;
+    struct mps_nbr_grid g = {0};
+    struct mps_nbr_list full = {0}, bare = {0}, ff = {0}, bf = {0}, fr = {0}, br = {0};
+    bare.no_r2 = bf.no_r2 = br.no_r2 = 1;
+    struct mps_err err = {0};
+    CHECK(mps_nbr_grid_build(&g, n, cx, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&full, &g, cx, n, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&bare, &g, cx, n, re, &err) == MPS_OK);
+    CHECK(bare.r2 == NULL);
+    /* move every particle by up to 0.4 l0, as a step within the skin does */
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < MPS_DIM; d++)
+            x[i][d] += 0.4 * l0 * (2.0 * urand(&seed) - 1.0);
+    CHECK(mps_nbr_list_filter(&ff, &full, cx, rs, &err) == MPS_OK);
+    CHECK(mps_nbr_list_filter(&bf, &bare, cx, rs, &err) == MPS_OK);
+    CHECK(bf.r2 == NULL);
+    CHECK(mps_nbr_list_reverse(&fr, &full, 0, nf, nf, n, &err) == MPS_OK);
+    CHECK(mps_nbr_list_reverse(&br, &bare, 0, nf, nf, n, &err) == MPS_OK);
+    CHECK(br.r2 == NULL);
+    const struct mps_nbr_list *a[3] = {&full, &ff, &fr}, *b[3] = {&bare, &bf, &br};
+    size_t bad = 0, pairs = 0;
+    for (int w = 0; w < 3; w++) {
+        for (size_t i = 0; i <= n; i++)
+            bad += a[w]->start[i] != b[w]->start[i];
+        for (size_t k = 0; k < a[w]->start[n] && k < b[w]->start[n]; k++)
+            bad += a[w]->j[k] != b[w]->j[k];
+        pairs += a[w]->start[n];
+    }
+    CHECK(bad == 0);
+    CHECK(ff.start[n] > 0 && ff.start[n] < full.start[n]);
+    printf("  no_r2: %zu pairs in build, filter and reverse, %zu differ\n", pairs, bad);
+    /* r2 wanted from a list that has none */
+    struct mps_nbr_list want = {0};
+    CHECK(mps_nbr_list_reverse(&want, &bare, 0, nf, nf, n, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "r2") != NULL);
+    struct mps_nbr_list *all[] = {&full, &bare, &ff, &bf, &fr, &br, &want};
+    for (int w = 0; w < 7; w++)
+        mps_nbr_list_free(all[w]);
+    mps_nbr_grid_free(&g);
+    free(x);
+}
+
 int main(void)
 {
     test_random();
     test_masked_reverse();
+    test_no_r2();
     test_lattice(1.0, 0.0);
     test_lattice(0.01, -0.35);
     test_errors();
