@@ -1,6 +1,7 @@
 /* realpath() is XSI */
 #define _XOPEN_SOURCE 700
 #include "mps_cli.h"
+#include "mps_version.h"
 
 #include <errno.h>
 #include <stdio.h>
@@ -16,6 +17,7 @@ static void print_help(const char *usage, const struct mps_cli_extra *extra, int
            "  --out DIR            output directory (created if missing)\n"
            "  --set KEY=VALUE      override a case-file key; repeatable\n"
            "  --quiet              no progress output\n"
+           "  --version            show the version and git revision it was built from\n"
            "  --help               show this help\n");
     for (int k = 0; k < nextra; k++) {
         char head[128];
@@ -63,12 +65,19 @@ enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
     for (int k = 0; k < nextra; k++)
         extra[k].value = NULL;
 
-    /* --help wins over everything else, even errors, so it always works. */
-    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++)
+    /* --help and --version win over everything else, even errors, so they
+     * always work. */
+    for (int i = 1; i < argc && strcmp(argv[i], "--") != 0; i++) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             print_help(usage, extra, nextra);
             return mps_err_set(err, MPS_EINTR, "help shown");
         }
+        if (!strcmp(argv[i], "--version")) {
+            const char *slash = strrchr(argv[0], '/');
+            printf("%s %s (git %s)\n", slash ? slash + 1 : argv[0], MPS_VERSION, mps_git_rev);
+            return mps_err_set(err, MPS_EINTR, "version shown");
+        }
+    }
 
     int options_done = 0;
     for (int i = 1; i < argc; i++) {

@@ -1,4 +1,5 @@
 #include "mps_h5.h"
+#include "mps_version.h"
 
 #include <errno.h>
 #include <hdf5.h>
@@ -499,7 +500,7 @@ enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, si
     if ((st = attr_num(fid, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &time, tmp, err)) ||
         (st = attr_num(fid, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step64, tmp, err)) ||
         (st = attr_str(fid, "code_version", MPS_VERSION, tmp, err)) ||
-        (st = attr_str(fid, "git_rev", MPS_GIT_REV, tmp, err)) ||
+        (st = attr_str(fid, "git_rev", mps_git_rev, tmp, err)) ||
         (st = attr_str(fid, "solver", s->solver, tmp, err)) ||
         (st = write_config(fid, s->config, tmp, err)))
         goto done;

@@ -18,6 +18,7 @@
 #include <zmq.h>
 
 #include "coupler_keys.h"
+#include "mps_version.h"
 #include "fluid_params.h"
 #include "launch.h"
 #include "mps_case.h"
@@ -526,7 +527,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_begin(&j, fp);
     mps_json_str(&j, "program", "coupler");
     mps_json_str(&j, "version", MPS_VERSION);
-    mps_json_str(&j, "git_rev", MPS_GIT_REV);
+    mps_json_str(&j, "git_rev", mps_git_rev);
     mps_json_str(&j, "case", c->cs ? mps_case_path(c->cs) : "");
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");

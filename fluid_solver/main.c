@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "fluid.h"
+#include "mps_version.h"
 #include "fluid_ppe.h"
 #include "mps_case.h"
 #include "mps_cli.h"
@@ -72,7 +73,7 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
     mps_json_begin(&j, fp);
     mps_json_str(&j, "solver", "fluid_solver");
     mps_json_str(&j, "version", MPS_VERSION);
-    mps_json_str(&j, "git_rev", MPS_GIT_REV);
+    mps_json_str(&j, "git_rev", mps_git_rev);
     mps_json_str(&j, "case", r->cs ? mps_case_path(r->cs) : "");
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");
@@ -313,7 +314,7 @@ int main(int argc, char **argv)
                         "       fluid_solver --connect ENDPOINT [--timeout S]   (under the coupler)";
     enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
     if (st == MPS_EINTR)
-        return 0; /* --help */
+        return 0; /* --help, --version */
     if (st) {
         fprintf(stderr, "fluid_solver: %s\n", err.msg);
         return mps_status_exit_code(st);

@@ -10,6 +10,7 @@
 #include <string.h>
 
 #include "mps_case.h"
+#include "mps_version.h"
 #include "mps_cli.h"
 #include "mps_h5.h"
 #include "mps_json.h"
@@ -69,7 +70,7 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
     mps_json_begin(&j, f);
     mps_json_str(&j, "solver", "solid_solver");
     mps_json_str(&j, "version", MPS_VERSION);
-    mps_json_str(&j, "git_rev", MPS_GIT_REV);
+    mps_json_str(&j, "git_rev", mps_git_rev);
     mps_json_str(&j, "case", mps_case_path(c));
     mps_json_int(&j, "particles", (long long)n);
     mps_json_int(&j, "steps", steps);
@@ -263,7 +264,7 @@ int main(int argc, char **argv)
     };
     enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
     if (st == MPS_EINTR)
-        return 0; /* --help */
+        return 0; /* --help, --version */
     if (st == MPS_OK)
         st = run(&cli, extra[0].value, &err);
     if (st != MPS_OK)

@@ -9,3 +9,9 @@ target_link_libraries(test_h5 PRIVATE ${HDF5_C_LIBRARIES})
 mps_add_test(test_probes_json_cli SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_probes_json_cli.c
   LABELS unit TIMEOUT 30)
 mps_add_test(test_nbr SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_nbr.c LABELS unit TIMEOUT 30)
+
+# --version of every program names the tree's current git revision.
+add_test(NAME version_git_rev
+  COMMAND ${CMAKE_COMMAND} -DSRC=${CMAKE_SOURCE_DIR} -DBIN=$<TARGET_FILE_DIR:fluid_solver>
+          -P ${CMAKE_CURRENT_LIST_DIR}/scripts/check_version.cmake)
+set_tests_properties(version_git_rev PROPERTIES LABELS unit TIMEOUT 30)

@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "../test_util.h"
+#include "mps_version.h"
 #include "mps_h5.h"
 
 #define N 7
@@ -202,7 +203,7 @@ static void check_fluid(const char *dir)
         CHECK(t == 0.1 * sn);
         CHECK(step == 10L * sn + 1234567890123L);
         CHECK(str_attr_is(f, "code_version", MPS_VERSION));
-        CHECK(str_attr_is(f, "git_rev", MPS_GIT_REV));
+        CHECK(str_attr_is(f, "git_rev", mps_git_rev));
         CHECK(str_attr_is(f, "solver", "fluid_solver"));
 
         hid_t d = H5Dopen2(f, "/config", H5P_DEFAULT);
