@@ -252,6 +252,20 @@ struct mps_nbr_scratch {
     size_t cap, cap2, capt, capt2;
 };
 
+/* One scratch per thread, kept in the list so a rebuild allocates nothing. */
+static int reserve_scratch(struct mps_nbr_list *l, int ntmax)
+{
+    if (l->nscratch >= ntmax)
+        return 0;
+    struct mps_nbr_scratch *sc = realloc(l->scratch, (size_t)ntmax * sizeof *sc);
+    if (!sc)
+        return -1;
+    memset(sc + l->nscratch, 0, (size_t)(ntmax - l->nscratch) * sizeof *sc);
+    l->scratch = sc;
+    l->nscratch = ntmax;
+    return 0;
+}
+
 /* One pass: each thread visits a contiguous block of queries into its own
  * buffer, then copies it to its place once the row offsets are known. */
 enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
@@ -275,14 +289,8 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
      * fluid queries its first particles only, and an even split by index
      * gave one thread nearly all the work. */
     const int ntmax = omp_get_max_threads();
-    if (l->nscratch < ntmax) {
-        struct mps_nbr_scratch *sc = realloc(l->scratch, (size_t)ntmax * sizeof *sc);
-        if (!sc)
-            return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
-        memset(sc + l->nscratch, 0, (size_t)(ntmax - l->nscratch) * sizeof *sc);
-        l->scratch = sc;
-        l->nscratch = ntmax;
-    }
+    if (reserve_scratch(l, ntmax))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
     size_t *bound = malloc(((size_t)ntmax + 1) * sizeof *bound);
     if (!bound)
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
@@ -353,51 +361,93 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
     return MPS_OK;
 }
 
+/* First row of thread t's block when nt threads share the candidates of
+ * src evenly (a fluid's tank rows are empty, so an even split of the rows
+ * would leave one thread idle). */
+static size_t even_split(const struct mps_nbr_list *src, int t, int nt)
+{
+    const size_t n = src->n, want = src->start[n] / (size_t)nt * (size_t)t;
+    if (t == 0)
+        return 0;
+    if (t == nt)
+        return n;
+    size_t lo = 0, hi = n; /* first row whose candidates start at or after want */
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (src->start[mid] < want)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* One pass over the candidates: each thread writes the kept pairs of its
+ * block of rows into its own buffer, then copies them to their place once
+ * the row offsets are known (two passes, count then write, read every
+ * candidate and its position twice). */
 enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_list *src,
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err)
 {
     const size_t n = src->n;
     const double r2max = radius * radius;
-    if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)))
+    const int ntmax = omp_get_max_threads();
+    if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)) ||
+        reserve_scratch(dst, ntmax))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
     dst->n = n;
     dst->radius = radius;
     dst->start[0] = 0;
     const int src_r2 = !src->no_r2, dst_r2 = !dst->no_r2;
-#pragma omp parallel for schedule(dynamic, 64)
-    for (size_t i = 0; i < n; i++) {
-        size_t m = 0;
-        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            double r2 = pair_r2(x, i, src->j[k]);
-            if (src_r2)
-                src->r2[k] = r2;
-            m += r2 < r2max;
-        }
-        dst->start[i + 1] = m;
-    }
-    for (size_t i = 0; i < n; i++)
-        dst->start[i + 1] += dst->start[i];
-    size_t npairs = dst->start[n];
-    if (grow_pairs(dst, npairs))
-        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory for %zu pairs", npairs);
-#pragma omp parallel for schedule(dynamic, 64)
-    for (size_t i = 0; i < n; i++) {
-        /* Every candidate is written and kept by advancing m (which of
-         * them pass has no order a branch predictor could learn); the
-         * m < end test fails only once the row is full. Without src's r2
-         * the distance is recomputed, the same arithmetic as above. */
-        size_t m = dst->start[i], end = dst->start[i + 1];
-        for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-            double r2 = src_r2 ? src->r2[k] : pair_r2(x, i, src->j[k]);
-            if (m < end) {
-                dst->j[m] = src->j[k];
-                if (dst_r2)
-                    dst->r2[m] = r2;
+    int fail = 0;
+#pragma omp parallel num_threads(ntmax)
+    {
+        const int t = omp_get_thread_num(), nt = omp_get_num_threads();
+        const size_t lo = even_split(src, t, nt), hi = even_split(src, t + 1, nt);
+        const size_t room = src->start[hi] - src->start[lo] + 1;
+        struct mps_nbr_scratch *sc = &dst->scratch[t];
+        int lfail = grow((void **)&sc->jb, &sc->cap, room, sizeof *sc->jb) ||
+                    (dst_r2 && grow((void **)&sc->rb, &sc->cap2, room, sizeof *sc->rb));
+        size_t used = 0;
+        if (!lfail)
+            for (size_t i = lo; i < hi; i++) {
+                /* every candidate is written, kept by advancing the count
+                 * (which pass follows no order a predictor could learn) */
+                size_t m = used;
+                for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
+                    const double r2 = pair_r2(x, i, src->j[k]);
+                    if (src_r2)
+                        src->r2[k] = r2;
+                    sc->jb[m] = src->j[k];
+                    if (dst_r2)
+                        sc->rb[m] = r2;
+                    m += r2 < r2max;
+                }
+                dst->start[i + 1] = m - used;
+                used = m;
             }
-            m += r2 < r2max;
+        if (lfail) {
+#pragma omp atomic write
+            fail = 1;
+        }
+#pragma omp barrier
+#pragma omp single
+        {
+            for (size_t i = 0; i < n && !fail; i++)
+                dst->start[i + 1] += dst->start[i];
+            if (!fail && grow_pairs(dst, dst->start[n]))
+                fail = 2;
+        }
+        if (!fail && used > 0) {
+            memcpy(dst->j + dst->start[lo], sc->jb, used * sizeof *sc->jb);
+            if (dst_r2)
+                memcpy(dst->r2 + dst->start[lo], sc->rb, used * sizeof *sc->rb);
         }
     }
+    if (fail)
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
+                           fail == 2 ? " for the pairs" : "");
     return MPS_OK;
 }
 
