@@ -310,21 +310,11 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
         int lo, hi;
         block(n, &lo, &hi);
         for (int i = lo; i < hi; i++) {
-            const int base = A->rowptr[i], end = A->rowptr[i + 1];
-            int *keys = azcol + base, len = 0, prev = agg[A->col[base]];
-            double *vals = azval + base, run = 0.0;
-            /* columns in particle order meet the same aggregate in runs of a
-             * few: sum a run in a register, merge it once it ends */
-            for (int k = base; k < end; k++) {
-                const int a = agg[A->col[k]];
-                if (a != prev) {
-                    accumulate(prev, run, i, stamp, slot, keys, vals, &len);
-                    prev = a;
-                    run = 0.0;
-                }
-                run += A->val[k];
-            }
-            accumulate(prev, run, i, stamp, slot, keys, vals, &len);
+            const int base = A->rowptr[i];
+            int len = 0;
+            for (int k = base; k < A->rowptr[i + 1]; k++)
+                accumulate(agg[A->col[k]], A->val[k], i, stamp, slot, azcol + base, azval + base,
+                           &len);
             azlen[i] = len;
             for (int q = 0; q < len; q++)
                 count[azcol[base + q]]++;
