@@ -444,18 +444,24 @@ enum mps_status fluid_defl_start(struct fluid_defl *s, const struct fluid_csr *A
     return MPS_OK;
 }
 
-/* p -= Z E^-1 (A Z)^T z */
-enum mps_status fluid_defl_project(struct fluid_defl *s, const struct fluid_csr *A,
-                                   const double *z, double *p, struct mps_err *err)
+/* p = z + beta p - Z E^-1 (A Z)^T z in one pass (beta = 0: p = z - ..., p's
+ * old content unread) */
+enum mps_status fluid_defl_direction(struct fluid_defl *s, const struct fluid_csr *A,
+                                     const double *z, double beta, double *p, struct mps_err *err)
 {
     const double *mu;
     enum mps_status rc = defl_coarse(s, A, z, 1, &mu, err);
     if (rc)
         return rc;
     const int n = A->n, *agg = s->agg;
+    if (beta == 0.0) {
 #pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static)
-    for (int i = 0; i < n; i++)
-        p[i] -= mu[agg[i]];
+        for (int i = 0; i < n; i++)
+            p[i] = z[i] - mu[agg[i]];
+    } else {
+#pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static)
+        for (int i = 0; i < n; i++)
+            p[i] = z[i] + beta * p[i] - mu[agg[i]];
+    }
     return MPS_OK;
 }
-

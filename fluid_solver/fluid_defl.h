@@ -2,7 +2,7 @@
  * fluid_linsolve.h): Z is the n x m indicator matrix of groups of rows close
  * in space, E = Z^T A Z the m x m coarse matrix, factorised with CHOLMOD at
  * every setup. The caller runs Jacobi CG and calls fluid_defl_start() once
- * on its initial residual and fluid_defl_project() on every new direction.
+ * on its initial residual and fluid_defl_direction() for every new direction.
  * See docs/ppe_solvers.md, "Deflation". */
 #ifndef FLUID_DEFL_H
 #define FLUID_DEFL_H
@@ -33,9 +33,12 @@ enum mps_status fluid_defl_setup(struct fluid_defl *d, const struct fluid_csr *A
 enum mps_status fluid_defl_start(struct fluid_defl *d, const struct fluid_csr *A, double *x,
                                  double *r, double *rr, struct mps_err *err);
 
-/* p -= Z E^-1 (A Z)^T z: p made A-orthogonal to range(Z). */
-enum mps_status fluid_defl_project(struct fluid_defl *d, const struct fluid_csr *A,
-                                   const double *z, double *p, struct mps_err *err);
+/* The next search direction, made A-orthogonal to range(Z):
+ * p = z + beta p - Z E^-1 (A Z)^T z (beta = 0: the first, p's content
+ * unread). */
+enum mps_status fluid_defl_direction(struct fluid_defl *d, const struct fluid_csr *A,
+                                     const double *z, double beta, double *p,
+                                     struct mps_err *err);
 
 /* m of the last setup (0 before the first). */
 int fluid_defl_coarse_size(const struct fluid_defl *d);

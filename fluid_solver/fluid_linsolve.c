@@ -822,8 +822,10 @@ static enum mps_status first_direction(struct fluid_linsolve *s, const struct fl
     if (s->defl && (rc = fluid_defl_start(s->defl, A, x, s->r, rr, err)))
         return rc;
     *rz = precond(s, n, s->r, s->z);
+    if (s->defl)
+        return fluid_defl_direction(s->defl, A, s->z, 0.0, s->p, err);
     memcpy(s->p, s->z, (size_t)n * sizeof *s->p);
-    return s->defl ? fluid_defl_project(s->defl, A, s->z, s->p, err) : MPS_OK;
+    return MPS_OK;
 }
 
 static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, const double *b,
@@ -912,8 +914,9 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         double rz_new = dinv ? upd[1] : ic0_apply(s, n, r, z);
         double beta = rz_new / rz;
         rz = rz_new;
-        k_direction(s, n, beta, z, p);
-        if (s->defl && (rc = fluid_defl_project(s->defl, A, z, p, err)))
+        if (!s->defl)
+            k_direction(s, n, beta, z, p);
+        else if ((rc = fluid_defl_direction(s->defl, A, z, beta, p, err)))
             return rc;
     }
     st->iterations = it;
