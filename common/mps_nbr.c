@@ -266,6 +266,33 @@ static int reserve_scratch(struct mps_nbr_list *l, int ntmax)
     return 0;
 }
 
+/* Called by every thread of a parallel region once its buffer sc holds the
+ * used pairs of its contiguous block of rows from lo, and l->start[i + 1]
+ * the count of each of its rows: turns the counts into offsets, makes room
+ * and copies each block into place. *fail (shared): 1 if a thread could not
+ * fill its buffer (lfail), 2 if there is no room for the pairs. */
+static void publish_rows(struct mps_nbr_list *l, size_t lo, const struct mps_nbr_scratch *sc,
+                         size_t used, int lfail, int *fail)
+{
+    if (lfail) {
+#pragma omp atomic write
+        *fail = 1;
+    }
+#pragma omp barrier
+#pragma omp single
+    {
+        for (size_t i = 0; i < l->n && !*fail; i++)
+            l->start[i + 1] += l->start[i];
+        if (!*fail && grow_pairs(l, l->start[l->n]))
+            *fail = 2;
+    }
+    if (!*fail && used > 0) {
+        memcpy(l->j + l->start[lo], sc->jb, used * sizeof *sc->jb);
+        if (!l->no_r2)
+            memcpy(l->r2 + l->start[lo], sc->rb, used * sizeof *sc->rb);
+    }
+}
+
 /* One pass: each thread visits a contiguous block of queries into its own
  * buffer, then copies it to its place once the row offsets are known. */
 enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct mps_nbr_grid *g,
@@ -284,7 +311,6 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
     l->radius = radius;
     l->start[0] = 0;
     int fail = 0;
-    size_t npairs = 0;
     /* Threads take contiguous blocks with equal numbers of queried rows: a
      * fluid queries its first particles only, and an even split by index
      * gave one thread nearly all the work. */
@@ -335,30 +361,12 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
             l->start[i + 1] = m;
             used += m;
         }
-        if (lfail) {
-#pragma omp atomic write
-            fail = 1;
-        }
-#pragma omp barrier
-#pragma omp single
-        {
-            for (size_t i = 0; i < nquery && !fail; i++)
-                l->start[i + 1] += l->start[i];
-            npairs = fail ? 0 : l->start[nquery];
-            if (!fail && grow_pairs(l, npairs))
-                fail = 2;
-        }
-        if (!fail && used > 0) {
-            memcpy(l->j + l->start[lo], sc->jb, used * sizeof *sc->jb);
-            if (want_r2)
-                memcpy(l->r2 + l->start[lo], sc->rb, used * sizeof *sc->rb);
-        }
+        publish_rows(l, lo, sc, used, lfail, &fail);
     }
     free(bound);
-    if (fail)
-        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
-                           fail == 2 ? " for the pairs" : "");
-    return MPS_OK;
+    return fail ? mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
+                              fail == 2 ? " for the pairs" : "")
+                : MPS_OK;
 }
 
 /* First row of thread t's block when nt threads share the candidates of
@@ -427,28 +435,11 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
                 dst->start[i + 1] = m - used;
                 used = m;
             }
-        if (lfail) {
-#pragma omp atomic write
-            fail = 1;
-        }
-#pragma omp barrier
-#pragma omp single
-        {
-            for (size_t i = 0; i < n && !fail; i++)
-                dst->start[i + 1] += dst->start[i];
-            if (!fail && grow_pairs(dst, dst->start[n]))
-                fail = 2;
-        }
-        if (!fail && used > 0) {
-            memcpy(dst->j + dst->start[lo], sc->jb, used * sizeof *sc->jb);
-            if (dst_r2)
-                memcpy(dst->r2 + dst->start[lo], sc->rb, used * sizeof *sc->rb);
-        }
+        publish_rows(dst, lo, sc, used, lfail, &fail);
     }
-    if (fail)
-        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
-                           fail == 2 ? " for the pairs" : "");
-    return MPS_OK;
+    return fail ? mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory%s",
+                              fail == 2 ? " for the pairs" : "")
+                : MPS_OK;
 }
 
 enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
