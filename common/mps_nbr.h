@@ -1,8 +1,10 @@
 /* O(N) neighbour search: a uniform cell list (counting sort of particles by
  * cell) and, from it, a compact neighbour list (CSR) of all pairs closer than
  * a radius. Cells are at least the radius wide, so a query visits the 3^d
- * surrounding cells. The list stores j and |r_ij|^2 so operators with smaller
- * radii can filter it without recomputing distances. */
+ * surrounding cells. The list stores j and, unless told not to (no_r2),
+ * |r_ij|^2 for users that need the distances at the positions of the build
+ * (a solid's reference bonds); a fluid, whose particles move between builds,
+ * recomputes them and keeps j only. */
 #ifndef MPS_NBR_H
 #define MPS_NBR_H
 
