@@ -19,6 +19,9 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
     return 0;
 }
 
+/* ppe_flag bits: what pass 1 needs to know of a neighbour, one load */
+enum { PPE_F_UNKNOWN = 1, PPE_F_GHOST = 2, PPE_F_SURFACE_FLUID = 4, PPE_F_ROW = 8 };
+
 /* Pass 1 for row particle i: packs the Laplacian neighbours that enter row i
  * (nonzero weight) at the front of its range of the list, their index in
  * f->wcol and c w_ij in f->wlap; returns their number in *nw, the number of
@@ -38,9 +41,6 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
  * 3 mm dam break, 2 threads: 1.60 to 1.52 ms per step for the assembly
  * (the same branch-free weight took the viscous Laplacian from 1.00 to
  * 0.65 ms). */
-/* ppe_flag bits: what pass 1 needs to know of a neighbour, one load */
-enum { PPE_F_UNKNOWN = 1, PPE_F_GHOST = 2, PPE_F_SURFACE_FLUID = 4, PPE_F_ROW = 8 };
-
 static int row_weights(struct fluid *f, size_t i, double c, double *diag, int *nw)
 {
     const double re = f->prm.re_lap * f->prm.dp;
