@@ -6,10 +6,28 @@ Prints the front Z(T) and height H(tau) errors at the table points up to
 T = tmax (tau up to the run's end), the max relative front error and whether
 it is within the issue's 10% target. Reference: cases/dambreak/martin_moyce.csv.
 """
-import argparse, csv, json, math, os, sys
+import argparse, csv, json, math, os, subprocess, sys, tempfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
 REF = os.path.join(HERE, '..', 'cases', 'dambreak', 'martin_moyce.csv')
+
+
+def run_dambreak(binary, threads, sets, prefix='db_', quiet_stderr=False):
+    """Runs cases/dambreak without snapshots, with `--set` for each of sets
+    ('key=value'), on `threads` OpenMP threads. Returns (output directory,
+    summary.json as a dict, whether it exited 0, the command relative to the
+    repository)."""
+    out = tempfile.mkdtemp(prefix=prefix)
+    cmd = [os.path.join(binary, 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
+           '--out', out, '--quiet', '--set', 'output.interval=0']
+    for kv in sets:
+        cmd += ['--set', kv]
+    rc = subprocess.run(cmd, env=dict(os.environ, OMP_NUM_THREADS=str(threads)),
+                        stderr=subprocess.PIPE if quiet_stderr else None).returncode
+    with open(os.path.join(out, 'summary.json')) as f:
+        summary = json.load(f)
+    return out, summary, rc == 0, ' '.join(cmd).replace(ROOT + '/', '')
 
 
 def load_ref(path=REF):

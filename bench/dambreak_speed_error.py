@@ -9,7 +9,7 @@ us per particle-step, the front's max and mean error against the
 measurements (table points up to T = 3), the same with the measurements
 taken 0.2 later in T (17 ms: the release time of the gate, docs/fluid.md),
 and the height error at the wall. Run it on a quiet machine."""
-import argparse, math, os, subprocess, sys, tempfile, json
+import argparse, math, os, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
@@ -42,16 +42,11 @@ def main():
           'front max / mean error | same, measurements 17 ms later | height max / mean error |')
     print('|---|---|---|---|---|---|---|---|')
     for dp in (float(d) for d in a.dps.split(',')):
-        out = tempfile.mkdtemp(prefix='dbse_')
-        cmd = [os.path.join(a.bin, 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
-               '--out', out, '--quiet', '--set', f'dp={dp}', '--set', f'end_time={a.end}',
-               '--set', 'output.interval=0']
-        env = dict(os.environ, OMP_NUM_THREADS=str(a.threads))
-        if subprocess.run(cmd, env=env).returncode != 0:
+        out, s, ok, _ = dc.run_dambreak(a.bin, a.threads, [f'dp={dp}', f'end_time={a.end}'],
+                                        prefix='dbse_')
+        if not ok:
             print(f'| {dp * 1e3:g} | run failed, see {out} |')
             continue
-        with open(os.path.join(out, 'summary.json')) as f:
-            s = json.load(f)
         r = dc.compare(out, A, 3.0)
         smax, smean = shifted_front(out)
         p = s['particles']

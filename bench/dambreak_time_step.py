@@ -8,25 +8,17 @@ and with droplets of fewer than 3 neighbours held to one spacing per step
 (=3): the 4 mm run to T = 3 against Martin & Moyce (front and height errors,
 bench/dambreak_compare.py) and the 3 mm run to 1 s (steps, wall time, whether
 it finished). Writes a markdown table. Run it on a quiet machine."""
-import argparse, json, os, subprocess, sys, tempfile
+import argparse, os, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
 from bench_doc import write_keeping_notes  # noqa: E402
-from dambreak_compare import compare  # noqa: E402
+from dambreak_compare import compare, run_dambreak  # noqa: E402
 
 
 def run(binary, threads, sets):
-    out = tempfile.mkdtemp(prefix='dbts_')
-    cmd = [os.path.join(binary, 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
-           '--out', out, '--quiet', '--set', 'output.interval=0']
-    for s in sets:
-        cmd += ['--set', s]
-    rc = subprocess.run(cmd, env=dict(os.environ, OMP_NUM_THREADS=str(threads)),
-                        stderr=subprocess.PIPE, text=True)
-    with open(os.path.join(out, 'summary.json')) as f:
-        summ = json.load(f)
-    return out, summ, rc.returncode == 0
+    out, summ, ok, _ = run_dambreak(binary, threads, sets, prefix='dbts_', quiet_stderr=True)
+    return out, summ, ok
 
 
 def main():

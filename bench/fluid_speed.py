@@ -8,24 +8,19 @@ per thread count, and tabulates ns per particle-step by phase from each run's
 summary.json. Also times the paper's coarsest dam break (dp = 3 mm, 4,656
 fluid particles) over 1 s of simulated time, with the case's time step and
 with the solver's defaults. Run it on a quiet machine."""
-import argparse, json, os, subprocess, sys, tempfile
+import argparse, os, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
 from bench_doc import write_keeping_notes  # noqa: E402
+from dambreak_compare import run_dambreak  # noqa: E402
 
 
 def run(binary, dp, end, threads, extra=()):
-    out = tempfile.mkdtemp(prefix='fspeed_')
-    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
-    cmd = [os.path.join(binary, 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
-           '--out', out, '--quiet', '--set', f'dp={dp}', '--set', f'end_time={end}',
-           '--set', 'output.interval=0', *extra]
-    rc = subprocess.run(cmd, env=env).returncode
-    with open(os.path.join(out, 'summary.json')) as f:
-        s = json.load(f)
-    s['failed'] = rc != 0
-    return s, ' '.join(cmd).replace(ROOT + '/', '')
+    _, s, ok, cmd = run_dambreak(binary, threads, [f'dp={dp}', f'end_time={end}', *extra],
+                                 prefix='fspeed_')
+    s['failed'] = not ok
+    return s, cmd
 
 
 def case_time_step():
@@ -76,7 +71,7 @@ def main():
               '| dp (mm) | fluid particles | time step | threads | steps | PPE iters/step | '
               'wall s | ns/particle-step |',
               '|---|---|---|---|---|---|---|---|']
-    defaults = ('--set', 'fluid.courant=0.2', '--set', 'fluid.droplet_neighbours=0')
+    defaults = ('fluid.courant=0.2', 'fluid.droplet_neighbours=0')
     cmds = []
     for label, extra, ts in (('case', (), threads), ('defaults', defaults, threads[-1:])):
         for t in ts:

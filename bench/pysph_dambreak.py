@@ -23,7 +23,7 @@ and y = 0 with their faces half a spacing in). Wall time: PySPH's own
 "Run took" (the time loop, without its Cython compilation and set-up); ours
 from summary.json (the same: the time loop without set-up). Prints one
 markdown row per code and spacing."""
-import argparse, glob, math, os, re, subprocess, sys, tempfile, json
+import argparse, glob, math, os, re, subprocess, sys, tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
@@ -84,15 +84,13 @@ def run_pysph(cols, threads, scheme, keep, nnps):
 
 
 def run_ours(dp, threads, binary):
-    out = tempfile.mkdtemp(prefix='db_ours_')
-    cmd = [os.path.join(binary, 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
-           '--out', out, '--quiet', '--set', f'dp={dp}', '--set', 'end_time=0.27',
-           '--set', 'output.interval=0']
-    subprocess.run(cmd, env=dict(os.environ, OMP_NUM_THREADS=str(threads)), check=True)
-    s = json.load(open(os.path.join(out, 'summary.json')))
+    out, s, ok, cmd = dc.run_dambreak(binary, threads, [f'dp={dp}', 'end_time=0.27'],
+                                      prefix='db_ours_')
+    if not ok:
+        sys.exit(f'fluid_solver failed: {s["message"]}')
     a = math.floor(0.146 / dp + 1e-9) * dp
     return dict(a=a, wall=s['step_seconds'], fluid=s['particles']['fluid'],
-                total=s['particles']['total'], steps=s['steps'], run=out, cmd=' '.join(cmd))
+                total=s['particles']['total'], steps=s['steps'], run=out, cmd=cmd)
 
 
 def row(code, label, r):

@@ -1,13 +1,14 @@
 /* realpath() is XSI */
 #define _XOPEN_SOURCE 700
 #include "mps_cli.h"
-#include "mps_version.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+
+#include "mps_version.h"
 
 static void print_help(const char *usage, const struct mps_cli_extra *extra, int nextra)
 {

@@ -1,5 +1,4 @@
 #include "mps_h5.h"
-#include "mps_version.h"
 
 #include <errno.h>
 #include <hdf5.h>
@@ -11,6 +10,7 @@
 #include <string.h>
 
 #include "mps_cli.h" /* mps_mkdir_p */
+#include "mps_version.h"
 
 /* XDMF notes (why the index looks the way it does):
  * - Version 2.0 with implicit Polyvertex topology (NumberOfElements, no

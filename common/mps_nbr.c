@@ -115,16 +115,6 @@ static int grow_pairs(struct mps_nbr_list *l, size_t npairs)
     return 0;
 }
 
-static inline double pair_r2(const double (*x)[MPS_DIM], size_t i, int j)
-{
-    double r2 = 0.0;
-    for (int d = 0; d < MPS_DIM; d++) {
-        double dx = x[j][d] - x[i][d];
-        r2 += dx * dx;
-    }
-    return r2;
-}
-
 /* The block of cells around particle i's cell that a query visits: columns
  * a0..a1 of rows b0..b1, clipped to the grid. */
 struct cell_window {
@@ -195,31 +185,22 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
         for (size_t q = 0; q < nruns; q += 2) {
             size_t p1 = runs[q], e1 = runs[q + 1];
             size_t p2 = q + 1 < nruns ? runs[q + 1] : e1, e2 = q + 1 < nruns ? runs[q + 2] : e1;
-            if (want_r2) {
-                while (p1 < e1 && p2 < e2) {
-                    if (js[p1] < js[p2]) {
-                        jd[o] = js[p1];
-                        rd[o++] = rs[p1++];
-                    } else {
-                        jd[o] = js[p2];
-                        rd[o++] = rs[p2++];
-                    }
-                }
-                for (; p1 < e1; p1++, o++) {
-                    jd[o] = js[p1];
+            while (p1 < e1 && p2 < e2) {
+                size_t from = js[p1] < js[p2] ? p1++ : p2++;
+                jd[o] = js[from];
+                if (want_r2)
+                    rd[o] = rs[from];
+                o++;
+            }
+            for (; p1 < e1; p1++, o++) {
+                jd[o] = js[p1];
+                if (want_r2)
                     rd[o] = rs[p1];
-                }
-                for (; p2 < e2; p2++, o++) {
-                    jd[o] = js[p2];
+            }
+            for (; p2 < e2; p2++, o++) {
+                jd[o] = js[p2];
+                if (want_r2)
                     rd[o] = rs[p2];
-                }
-            } else {
-                while (p1 < e1 && p2 < e2)
-                    jd[o++] = js[p1] < js[p2] ? js[p1++] : js[p2++];
-                for (; p1 < e1; p1++, o++)
-                    jd[o] = js[p1];
-                for (; p2 < e2; p2++, o++)
-                    jd[o] = js[p2];
             }
             runs[++nr] = o;
         }
@@ -392,8 +373,8 @@ static size_t even_split(const struct mps_nbr_list *src, int t, int nt)
 
 /* One pass over the candidates: each thread writes the kept pairs of its
  * block of rows into its own buffer, then copies them to their place once
- * the row offsets are known (two passes, count then write, read every
- * candidate and its position twice). */
+ * the row offsets are known (rather than counting in one pass and writing
+ * in a second, which reads every candidate and its position twice). */
 enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_list *src,
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err)
@@ -423,8 +404,9 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
                 /* every candidate is written, kept by advancing the count
                  * (which pass follows no order a predictor could learn) */
                 size_t m = used;
+                double d[MPS_DIM];
                 for (size_t k = src->start[i]; k < src->start[i + 1]; k++) {
-                    const double r2 = pair_r2(x, i, src->j[k]);
+                    const double r2 = mps_pair_delta(x, i, (size_t)src->j[k], d);
                     if (src_r2)
                         src->r2[k] = r2;
                     sc->jb[m] = src->j[k];

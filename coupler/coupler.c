@@ -18,7 +18,6 @@
 #include <zmq.h>
 
 #include "coupler_keys.h"
-#include "mps_version.h"
 #include "fluid_params.h"
 #include "launch.h"
 #include "mps_case.h"
@@ -28,6 +27,7 @@
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
+#include "mps_version.h"
 #include "proto_link.h"
 #include "solid_scene.h"
 

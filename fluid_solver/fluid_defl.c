@@ -17,6 +17,7 @@
 #include <cholmod.h>
 
 #include "mps_mem.h"
+#include "mps_omp.h"
 
 struct fluid_defl {
     int nthreads, par_min_rows;
@@ -40,14 +41,6 @@ struct fluid_defl {
     cholmod_dense *Xc, *Yc, *Ec;
     int coarse_n;        /* size of the last coarse system (statistics) */
 };
-
-/* thread t of nt's contiguous block of n rows */
-static inline void block(int n, int *lo, int *hi)
-{
-    int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    *lo = (int)((long long)n * t / nt);
-    *hi = (int)((long long)n * (t + 1) / nt);
-}
 
 static enum mps_status coarse_fail(struct fluid_defl *s, const char *call, struct mps_err *err)
 {
@@ -308,7 +301,7 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
             count[a] = 0;
         }
         int lo, hi;
-        block(n, &lo, &hi);
+        mps_omp_block(n, &lo, &hi);
         for (int i = lo; i < hi; i++) {
             const int base = A->rowptr[i];
             int len = 0;

@@ -14,6 +14,7 @@
 #include <cholmod.h>
 
 #include "mps_mem.h"
+#include "mps_omp.h"
 
 enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE, M_PCG_SIC0, M_PCG_DEFL };
 
@@ -430,13 +431,6 @@ static enum mps_status check_input(const struct fluid_linsolve *s, const struct 
  * they are added in thread order, so results are reproducible for a given
  * thread count. */
 
-static inline void block(int n, int *lo, int *hi)
-{
-    int t = omp_get_thread_num(), nt = omp_get_num_threads();
-    *lo = (int)((long long)n * t / nt);
-    *hi = (int)((long long)n * (t + 1) / nt);
-}
-
 /* Four partial sums: with one, a row of ~50 entries is a chain of ~50
  * dependent additions. Measured on the 3 mm dam break, 2 threads: the PPE
  * solve 2.88 to 2.66 ms per step, same iterations. The order is fixed, so
@@ -477,7 +471,7 @@ static void k_residual(struct fluid_linsolve *s, int nt, const struct fluid_csr 
 #pragma omp parallel num_threads(nt) if (n >= PAR_MIN_ROWS)
     {
         int lo, hi;
-        block(n, &lo, &hi);
+        mps_omp_block(n, &lo, &hi);
         double rr = 0.0, bb = 0.0;
         for (int i = lo; i < hi; i++) {
             double ri = b[i] - row_dot(A, i, x);
@@ -503,7 +497,7 @@ static double k_spmv_dot(struct fluid_linsolve *s, const struct fluid_csr *A, co
 #pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
     {
         int lo, hi;
-        block(n, &lo, &hi);
+        mps_omp_block(n, &lo, &hi);
         double pq = 0.0;
         for (int i = lo; i < hi; i++) {
             double qi = row_dot(A, i, p);
@@ -527,7 +521,7 @@ static void k_update(struct fluid_linsolve *s, int n, double a, const double *p,
 #pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
     {
         int lo, hi;
-        block(n, &lo, &hi);
+        mps_omp_block(n, &lo, &hi);
         double rr = 0.0, rz = 0.0;
         if (dinv) {
             for (int i = lo; i < hi; i++) {
@@ -565,7 +559,7 @@ static double k_jacobi(struct fluid_linsolve *s, int n, const double *r, double 
 #pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
     {
         int lo, hi;
-        block(n, &lo, &hi);
+        mps_omp_block(n, &lo, &hi);
         double rz = 0.0;
         for (int i = lo; i < hi; i++) {
             z[i] = dinv[i] * r[i];
@@ -585,7 +579,7 @@ static void k_direction(struct fluid_linsolve *s, int n, double beta, const doub
 #pragma omp parallel num_threads(s->nthreads) if (n >= PAR_MIN_ROWS)
     {
         int lo, hi;
-        block(n, &lo, &hi);
+        mps_omp_block(n, &lo, &hi);
         for (int i = lo; i < hi; i++)
             p[i] = z[i] + beta * p[i];
     }

@@ -11,7 +11,6 @@
 #include <string.h>
 
 #include "fluid.h"
-#include "mps_version.h"
 #include "fluid_ppe.h"
 #include "mps_case.h"
 #include "mps_cli.h"
@@ -19,6 +18,7 @@
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
+#include "mps_version.h"
 #include "proto_solver.h"
 
 static volatile int stop_signal = 0;

@@ -10,13 +10,13 @@
 #include <string.h>
 
 #include "mps_case.h"
-#include "mps_version.h"
 #include "mps_cli.h"
 #include "mps_h5.h"
 #include "mps_json.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
+#include "mps_version.h"
 #include "proto_solver.h"
 #include "solid_model.h"
 #include "solid_peer.h"

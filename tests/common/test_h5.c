@@ -9,8 +9,8 @@
 #include <unistd.h>
 
 #include "../test_util.h"
-#include "mps_version.h"
 #include "mps_h5.h"
+#include "mps_version.h"
 
 #define N 7
 
