@@ -46,19 +46,28 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
-        double acc[MPS_DIM] = {0};
-        for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
-            int j = nl->j[k];
-            if (!USE(in, j))
-                continue;
-            double r2 = 0.0;
-            for (int d = 0; d < MPS_DIM; d++) {
-                double dx = in->x[j][d] - in->x[i][d];
-                r2 += dx * dx;
+        double acc[MPS_DIM] = {0}, w[MPS_WEIGHT_CHUNK];
+        /* in chunks: distances, weights packed (mps_weights_r2), sums */
+        for (size_t c0 = nl->start[i]; c0 < nl->start[i + 1]; c0 += MPS_WEIGHT_CHUNK) {
+            const size_t len = nl->start[i + 1] - c0 < MPS_WEIGHT_CHUNK ? nl->start[i + 1] - c0
+                                                                        : MPS_WEIGHT_CHUNK;
+            for (size_t k = 0; k < len; k++) {
+                int j = nl->j[c0 + k];
+                double r2 = 0.0;
+                for (int d = 0; d < MPS_DIM; d++) {
+                    double dx = in->x[j][d] - in->x[i][d];
+                    r2 += dx * dx;
+                }
+                w[k] = r2;
             }
-            double w = mps_weight_r2(r2, in->re);
-            for (int d = 0; d < MPS_DIM; d++)
-                acc[d] += (f[j][d] - f[i][d]) * w;
+            mps_weights_r2(w, len, in->re, 1.0);
+            for (size_t k = 0; k < len; k++) {
+                int j = nl->j[c0 + k];
+                if (!USE(in, j))
+                    continue;
+                for (int d = 0; d < MPS_DIM; d++)
+                    acc[d] += (f[j][d] - f[i][d]) * w[k];
+            }
         }
         for (int d = 0; d < MPS_DIM; d++)
             lap[i][d] = coef * acc[d];

@@ -272,6 +272,24 @@ static void test_kernel(void)
         same &= mps_weight_r2(r * r, re) == mps_weight(sqrt(r * r), re);
     }
     CHECK(same);
+
+    /* The packed form (mps_weights_r2) gives the same bits as the scalar
+     * one times the scale, for an odd count (the scalar tail runs too), with
+     * r = 0, r = re and r beyond re among them. */
+    enum { NW = 2001 };
+    static double w[NW], r2[NW];
+    const double scale = 3.7;
+    for (int k = 0; k < NW; k++) {
+        double r = 1.2 * re * k / (NW - 1);
+        r2[k] = w[k] = r * r;
+    }
+    r2[NW / 2] = w[NW / 2] = re * re;
+    mps_weights_r2(w, NW, re, scale);
+    same = 1;
+    for (int k = 0; k < NW; k++)
+        same &= w[k] == scale * mps_weight_r2(r2[k], re);
+    CHECK(same);
+    CHECK(w[0] == 0.0 && w[NW / 2] == 0.0 && w[NW - 1] == 0.0 && w[1] > 0.0);
 }
 
 /* Lists that keep only j (no_r2, as the fluid's): the same pairs in the same
