@@ -172,8 +172,16 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
                     r2tmp[m] = r2;
                 m += (r2 < r2max) & (j != i);
             }
-            if (m > runs[nruns])
-                runs[++nruns] = m;
+            /* A cell whose first kept j follows the last one before it
+             * extends the current run rather than opening one to merge:
+             * the fluid is numbered in the grid's cell order (fluid.c), so
+             * most windows arrive sorted but for the tank's cells. */
+            if (m > runs[nruns]) {
+                if (nruns > 0 && jtmp[runs[nruns]] > jtmp[runs[nruns] - 1])
+                    runs[nruns] = m;
+                else
+                    runs[++nruns] = m;
+            }
         }
     }
     /* merge the runs pairwise until one is left, ping-ponging between the
@@ -509,7 +517,26 @@ void mps_nbr_list_free(struct mps_nbr_list *l)
     memset(l, 0, sizeof *l);
 }
 
-void mps_nbr_cell_order(const struct mps_nbr_grid *g, size_t *perm)
+enum mps_status mps_nbr_grid_cell_order(struct mps_nbr_grid *g, size_t m, size_t *perm,
+                                        struct mps_err *err)
 {
-    memcpy(perm, g->sorted, g->n * sizeof(size_t));
+    size_t *inv = malloc((m > 0 ? m : 1) * sizeof *inv);
+    if (!inv)
+        return mps_err_set(err, MPS_ENOMEM, "neighbour grid: out of memory renumbering");
+    size_t k = 0;
+    for (size_t c = 0; c < g->n; c++)
+        if (g->sorted[c] < m) {
+            inv[g->sorted[c]] = k;
+            perm[k++] = g->sorted[c];
+        }
+    /* the grid as if built after the renumbering: the same cells and
+     * slots, the new indices */
+    for (size_t c = 0; c < g->n; c++)
+        if (g->sorted[c] < m)
+            g->sorted[c] = inv[g->sorted[c]];
+    for (size_t i = 0; i < m; i++)
+        inv[i] = g->cell_of[perm[i]];
+    memcpy(g->cell_of, inv, m * sizeof *inv);
+    free(inv);
+    return MPS_OK;
 }

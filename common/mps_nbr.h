@@ -80,8 +80,11 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err);
 
-/* Permutation that orders particles by cell (for mps_particles_permute):
- * perm[k] = old index of the k-th particle. perm has g->n entries. */
-void mps_nbr_cell_order(const struct mps_nbr_grid *g, size_t *perm);
+/* Numbers the first m particles of the grid in cell order: perm[k] (m
+ * entries) = the old index of the particle numbered k, for
+ * mps_particles_permute, and the grid is updated to the new numbers, as if
+ * built after the renumbering. */
+enum mps_status mps_nbr_grid_cell_order(struct mps_nbr_grid *g, size_t m, size_t *perm,
+                                        struct mps_err *err);
 
 #endif

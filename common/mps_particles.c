@@ -1,5 +1,6 @@
 #include "mps_particles.h"
 
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -50,23 +51,56 @@ enum mps_status mps_particles_resize(struct mps_particles *ps, size_t n, struct 
     return MPS_OK;
 }
 
-enum mps_status mps_particles_permute(struct mps_particles *ps, const size_t *perm,
+/* new[i] = old[perm[i]] for one array of m elements of b bytes, through tmp.
+ * The common sizes are copied as whole words: a memcpy call per element
+ * (its size only known at run time) made the reordering cost more than
+ * what it saves the neighbour search. */
+static void permute_array(char *restrict d, char *restrict tmp, size_t b, const size_t *perm,
+                          size_t m)
+{
+    switch (b) {
+    case 1:
+        for (size_t i = 0; i < m; i++)
+            tmp[i] = d[perm[i]];
+        break;
+    case 4:
+        for (size_t i = 0; i < m; i++)
+            memcpy(tmp + 4 * i, d + 4 * perm[i], 4);
+        break;
+    case 8:
+        for (size_t i = 0; i < m; i++)
+            memcpy(tmp + 8 * i, d + 8 * perm[i], 8);
+        break;
+    case 16:
+        for (size_t i = 0; i < m; i++)
+            memcpy(tmp + 16 * i, d + 16 * perm[i], 16);
+        break;
+    default:
+        for (size_t i = 0; i < m; i++)
+            memcpy(tmp + b * i, d + b * perm[i], b);
+    }
+    memcpy(d, tmp, m * b);
+}
+
+enum mps_status mps_particles_permute(struct mps_particles *ps, const size_t *perm, size_t m,
                                       struct mps_err *err)
 {
+    if (m > ps->n)
+        return mps_err_set(err, MPS_EINPUT, "particles: reordering %zu of %zu", m, ps->n);
     size_t maxb = 0;
     for (int k = 0; k < ps->nfields; k++)
         if (field_bytes(&ps->f[k]) > maxb)
             maxb = field_bytes(&ps->f[k]);
-    char *tmp = malloc(ps->n * maxb + 1);
+    /* the fields are independent: one per thread at a time, each thread
+     * with its own buffer */
+    const int nt = omp_get_max_threads();
+    char *tmp = malloc((size_t)nt * (m * maxb + 64));
     if (!tmp)
-        return mps_err_set(err, MPS_ENOMEM, "particles: no memory to reorder %zu", ps->n);
-    for (int k = 0; k < ps->nfields; k++) {
-        size_t b = field_bytes(&ps->f[k]);
-        char *d = *ps->f[k].data;
-        for (size_t i = 0; i < ps->n; i++)
-            memcpy(tmp + i * b, d + perm[i] * b, b);
-        memcpy(d, tmp, ps->n * b);
-    }
+        return mps_err_set(err, MPS_ENOMEM, "particles: no memory to reorder %zu", m);
+#pragma omp parallel for num_threads(nt) schedule(dynamic, 1) if (m >= 4096)
+    for (int k = 0; k < ps->nfields; k++)
+        permute_array(*ps->f[k].data, tmp + (size_t)omp_get_thread_num() * (m * maxb + 64),
+                      field_bytes(&ps->f[k]), perm, m);
     free(tmp);
     return MPS_OK;
 }

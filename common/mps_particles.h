@@ -34,8 +34,9 @@ void mps_particles_add_field(struct mps_particles *ps, const char *name, int nco
                              int output);
 /* Sets the count to n, growing every array (new entries zeroed). */
 enum mps_status mps_particles_resize(struct mps_particles *ps, size_t n, struct mps_err *err);
-/* Reorders every field: new[i] = old[perm[i]] for i < n. */
-enum mps_status mps_particles_permute(struct mps_particles *ps, const size_t *perm,
+/* Reorders the first m particles of every field: new[i] = old[perm[i]] for
+ * i < m, perm a permutation of 0 .. m-1; the others stay. */
+enum mps_status mps_particles_permute(struct mps_particles *ps, const size_t *perm, size_t m,
                                       struct mps_err *err);
 /* Fills out (room for max) with the output fields; returns how many. */
 int mps_particles_output(const struct mps_particles *ps, struct mps_field *out, int max);

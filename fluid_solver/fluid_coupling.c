@@ -56,7 +56,7 @@ static enum mps_status remove_walls_under_solid(struct fluid *f, size_t n, const
             perm[keep++] = i;
     }
     memcpy(perm + keep, dropped, drop * sizeof *perm);
-    enum mps_status st = drop ? mps_particles_permute(&f->ps, perm, err) : MPS_OK;
+    enum mps_status st = drop ? mps_particles_permute(&f->ps, perm, ntot, err) : MPS_OK;
     free(perm);
     free(dropped);
     if (st)

@@ -735,7 +735,7 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
          * when 1% of the lower-triangle couplings are dropped, 1.55x at 6%,
          * 1.7x at 10%, 2.2x at 23%, while a 2-block iteration costs 1/1.85 of
          * a sequential one. A row-major lattice numbering, which particles
-         * sorted by cell resemble (fluid.c sorts every 20 steps), drops about
+         * sorted by cell resemble (fluid.c sorts at every list build), drops about
          * 1%; a scrambled numbering drops half. */
         if (nblk == 1 || dropped <= 0.1 * (double)(dropped + kept))
             break;

@@ -217,9 +217,9 @@ static int cmp_key_row(const void *a, const void *b)
 }
 
 /* pcg_defl's aggregates: the PPE rows in each square cell of side
- * fluid.ppe_coarse_cell spacings (at x*), numbered as they first appear in
- * particle order (which is roughly cell order). A direct cell -> aggregate
- * map when the rows' bounding box has few enough cells, else a sort. */
+ * fluid.ppe_coarse_cell spacings (at x*). A direct cell -> aggregate map,
+ * numbered along the box's shorter side first, when the rows' bounding box
+ * has few enough cells, else a sort by cell (row-major). */
 static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err *err)
 {
     const size_t n = f->ps.n, nr = (size_t)f->nrows;

@@ -8,6 +8,7 @@
 #include "../test_util.h"
 #include "mps_kernel.h"
 #include "mps_nbr.h"
+#include "mps_particles.h"
 
 /* Compares the CSR list of the first nquery particles with a brute-force
  * search computing r2 the same way (so the values are bit-identical). */
@@ -101,6 +102,104 @@ static void test_random(void)
     }
     compare("dense re=2.1", n, cx, n, 2.1 * l0, 2.1 * l0);
     free(x);
+}
+
+/* Numbering the first m particles in cell order (as the fluid is before each
+ * list build): perm is a permutation, the renumbered particles follow the
+ * grid's slots, and the updated grid and its list are those of a grid built
+ * from scratch at the renumbered positions. */
+static void test_cell_order(void)
+{
+    const size_t n = 1500, m = 900;
+    const double l0 = 0.01, re = 5.0 * l0;
+    double (*x)[MPS_DIM] = malloc(n * sizeof *x), (*y)[MPS_DIM] = malloc(n * sizeof *y);
+    size_t *perm = malloc(m * sizeof *perm);
+    unsigned char *seen = calloc(m, 1);
+    unsigned long long seed = 4242;
+    for (size_t i = 0; i < n; i++) {
+        x[i][0] = 40 * l0 * urand(&seed);
+        x[i][1] = 30 * l0 * urand(&seed);
+    }
+    struct mps_nbr_grid g = {0}, g2 = {0};
+    struct mps_nbr_list l = {0}, l2 = {0};
+    struct mps_err err = {0};
+    CHECK(mps_nbr_grid_build(&g, n, (const double(*)[MPS_DIM])x, re, &err) == MPS_OK);
+    CHECK(mps_nbr_grid_cell_order(&g, m, perm, &err) == MPS_OK);
+    int ok = 1;
+    for (size_t k = 0; k < m; k++) {
+        ok &= perm[k] < m && !seen[perm[k]];
+        if (perm[k] < m)
+            seen[perm[k]] = 1;
+    }
+    CHECK(ok);
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < MPS_DIM; d++)
+            y[i][d] = i < m ? x[perm[i]][d] : x[i][d];
+    size_t last = 0, descents = 0;
+    for (size_t c = 0, first = 1; c < g.n; c++)
+        if (g.sorted[c] < m) {
+            descents += !first && g.sorted[c] < last;
+            last = g.sorted[c];
+            first = 0;
+        }
+    CHECK(descents == 0);
+    CHECK(mps_nbr_grid_build(&g2, n, (const double(*)[MPS_DIM])y, re, &err) == MPS_OK);
+    CHECK(!memcmp(g.sorted, g2.sorted, n * sizeof *g.sorted));
+    CHECK(!memcmp(g.cell_of, g2.cell_of, n * sizeof *g.cell_of));
+    CHECK(mps_nbr_list_build(&l, &g, (const double(*)[MPS_DIM])y, n, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&l2, &g2, (const double(*)[MPS_DIM])y, n, re, &err) == MPS_OK);
+    CHECK(l.start[n] == l2.start[n] && !memcmp(l.start, l2.start, (n + 1) * sizeof *l.start) &&
+          !memcmp(l.j, l2.j, l.start[n] * sizeof *l.j));
+    mps_nbr_list_free(&l);
+    mps_nbr_list_free(&l2);
+    mps_nbr_grid_free(&g);
+    mps_nbr_grid_free(&g2);
+    free(x);
+    free(y);
+    free(perm);
+    free(seen);
+}
+
+/* mps_particles_permute moves every field, whatever its element size (1, 4,
+ * 8, 16 bytes and, through the general copy, 24), for the first m
+ * particles only; asking for more than there are is an error. */
+static void test_particles_permute(void)
+{
+    struct mps_particles ps;
+    unsigned char *u8 = NULL;
+    int *i32 = NULL;
+    double *f1 = NULL, (*f2)[2] = NULL, (*f3)[3] = NULL;
+    mps_particles_init(&ps);
+    mps_particles_add_field(&ps, "u8", 1, MPS_U8, (void **)&u8, "", 0);
+    mps_particles_add_field(&ps, "i32", 1, MPS_I32, (void **)&i32, "", 0);
+    mps_particles_add_field(&ps, "f1", 1, MPS_F64, (void **)&f1, "", 0);
+    mps_particles_add_field(&ps, "f2", 2, MPS_F64, (void **)&f2, "", 0);
+    mps_particles_add_field(&ps, "f3", 3, MPS_F64, (void **)&f3, "", 0);
+    struct mps_err err = {0};
+    const size_t n = 5000, m = 4500; /* above the size at which fields go in parallel */
+    CHECK(mps_particles_resize(&ps, n, &err) == MPS_OK);
+    for (size_t i = 0; i < n; i++) {
+        u8[i] = (unsigned char)(i % 251);
+        i32[i] = (int)i;
+        f1[i] = (double)i;
+        f2[i][0] = f2[i][1] = f3[i][0] = f3[i][2] = (double)i;
+        f3[i][1] = -(double)i;
+    }
+    size_t *perm = malloc(m * sizeof *perm);
+    for (size_t k = 0; k < m; k++)
+        perm[k] = (k * 7919) % m; /* 7919 is prime and does not divide 4500 */
+    CHECK(mps_particles_permute(&ps, perm, m, &err) == MPS_OK);
+    int ok = 1;
+    for (size_t i = 0; i < n; i++) {
+        size_t o = i < m ? perm[i] : i;
+        ok &= u8[i] == o % 251 && i32[i] == (int)o && f1[i] == (double)o && f2[i][0] == (double)o &&
+              f2[i][1] == (double)o && f3[i][0] == (double)o && f3[i][1] == -(double)o &&
+              f3[i][2] == (double)o;
+    }
+    CHECK(ok);
+    CHECK(mps_particles_permute(&ps, perm, n + 1, &err) == MPS_EINPUT);
+    free(perm);
+    mps_particles_free(&ps);
 }
 
 /* A masked build equals the full one on the queried rows and leaves the
@@ -352,6 +451,8 @@ int main(void)
 {
     test_random();
     test_masked_reverse();
+    test_cell_order();
+    test_particles_permute();
     test_no_r2();
     test_lattice(1.0, 0.0);
     test_lattice(0.01, -0.35);
