@@ -15,6 +15,7 @@
 #include "mps_case.h"
 #include "mps_cli.h"
 #include "mps_json.h"
+#include "mps_omp.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
@@ -45,6 +46,7 @@ struct run {
     size_t load_cap;
     char out_buf[4096];
     char probe_names[4096];
+    char cpu_note[96];   /* what mps_omp_bind_threads did (standalone runs) */
 };
 
 static enum mps_status write_snapshot(struct run *r, struct mps_err *err)
@@ -84,6 +86,8 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
         mps_json_num(&j, "compute_seconds", r->peer.compute_seconds);
         mps_json_num(&j, "wait_seconds", r->peer.wait_seconds);
     }
+    if (r->cpu_note[0])
+        mps_json_str(&j, "cpu_binding", r->cpu_note);
     if (r->f)
         fluid_summary(r->f, &j);
     mps_json_end(&j);
@@ -322,6 +326,7 @@ int main(int argc, char **argv)
     struct run r = {.out = cli.out_dir ? cli.out_dir : "out", .quiet = cli.quiet,
                     .summary_name = "summary.json"};
     r.wall0 = mps_wall_seconds();
+    mps_omp_bind_threads(r.cpu_note, sizeof r.cpu_note);
     st = setup(&r, cli.case_path, cli.sets, cli.nsets, "fluid", &err);
     if (st == MPS_OK) {
         if (extra[0].value) {

@@ -37,3 +37,11 @@ add_test(NAME fluid_ppe_scaling
 set_tests_properties(fluid_valid_hydrostatic fluid_valid_dambreak fluid_stable_dambreak
   fluid_ppe_scaling
   PROPERTIES LABELS validation TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=1")
+
+# Standalone runs bind their OpenMP threads to CPUs unless the user (or the
+# coupler) set OMP_PLACES / OMP_PROC_BIND (common/mps_omp.h).
+add_test(NAME fluid_cpu_binding
+  COMMAND ${CMAKE_COMMAND} -DSOLVER=${FV_SOLVER} -DOUT=${FV_OUT}/binding
+          -P ${FV_DIR}/scripts/check_binding.cmake
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_cpu_binding PROPERTIES LABELS integration TIMEOUT 60)
