@@ -240,18 +240,22 @@ static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for the coarse space");
     int m = 0;
     if (direct) {
-        /* mark the occupied cells, number them along the shorter side of
-         * the box first, then label the rows: E's bandwidth is then the
-         * short side's count of cells, small enough on a spread-out flow
-         * for a band factor (fluid_defl.c, NATURAL_MAX_BW) */
+        /* each row's cell (in agg for now) and the occupied cells, then
+         * the cells numbered along the shorter side of the box first: E's
+         * bandwidth is then the short side's count of cells, small enough
+         * on a spread-out flow for a band factor (fluid_defl.c,
+         * NATURAL_MAX_BW) */
         const size_t ny = (size_t)nyd;
         for (size_t c = 0; c < ncell; c++)
             f->aggmap[c] = -1;
-        for (size_t i = 0; i < n; i++)
-            if (f->row[i] >= 0) {
-                size_t cx = (size_t)((f->x[i][0] - lo[0]) / h), cy = (size_t)((f->x[i][1] - lo[1]) / h);
-                f->aggmap[cy * nx + cx] = 0;
-            }
+        for (size_t i = 0; i < n; i++) {
+            int r = f->row[i];
+            if (r < 0)
+                continue;
+            size_t cx = (size_t)((f->x[i][0] - lo[0]) / h), cy = (size_t)((f->x[i][1] - lo[1]) / h);
+            f->agg[r] = (int)(cy * nx + cx);
+            f->aggmap[cy * nx + cx] = 0;
+        }
         const int y_fast = ny <= nx;
         const size_t nslow = y_fast ? nx : ny, nfast = y_fast ? ny : nx;
         for (size_t a = 0; a < nslow; a++)
@@ -260,13 +264,8 @@ static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err
                 if (*c == 0)
                     *c = ++m;
             }
-        for (size_t i = 0; i < n; i++) {
-            int r = f->row[i];
-            if (r < 0)
-                continue;
-            size_t cx = (size_t)((f->x[i][0] - lo[0]) / h), cy = (size_t)((f->x[i][1] - lo[1]) / h);
-            f->agg[r] = f->aggmap[cy * nx + cx] - 1;
-        }
+        for (size_t r = 0; r < nr; r++)
+            f->agg[r] = f->aggmap[f->agg[r]] - 1;
     } else {
         for (size_t i = 0, k = 0; i < n; i++) {
             if (f->row[i] < 0)
