@@ -520,23 +520,18 @@ void mps_nbr_list_free(struct mps_nbr_list *l)
 enum mps_status mps_nbr_grid_cell_order(struct mps_nbr_grid *g, size_t m, size_t *perm,
                                         struct mps_err *err)
 {
-    size_t *inv = malloc((m > 0 ? m : 1) * sizeof *inv);
-    if (!inv)
+    size_t *cell = malloc((m > 0 ? m : 1) * sizeof *cell);
+    if (!cell)
         return mps_err_set(err, MPS_ENOMEM, "neighbour grid: out of memory renumbering");
-    size_t k = 0;
-    for (size_t c = 0; c < g->n; c++)
-        if (g->sorted[c] < m) {
-            inv[g->sorted[c]] = k;
-            perm[k++] = g->sorted[c];
-        }
     /* the grid as if built after the renumbering: the same cells and
-     * slots, the new indices */
-    for (size_t c = 0; c < g->n; c++)
-        if (g->sorted[c] < m)
-            g->sorted[c] = inv[g->sorted[c]];
-    for (size_t i = 0; i < m; i++)
-        inv[i] = g->cell_of[perm[i]];
-    memcpy(g->cell_of, inv, m * sizeof *inv);
-    free(inv);
+     * slots, the particle in the k-th renumbered slot numbered k */
+    for (size_t c = 0, k = 0; c < g->n; c++)
+        if (g->sorted[c] < m) {
+            perm[k] = g->sorted[c];
+            cell[k] = g->cell_of[perm[k]];
+            g->sorted[c] = k++;
+        }
+    memcpy(g->cell_of, cell, m * sizeof *cell);
+    free(cell);
     return MPS_OK;
 }

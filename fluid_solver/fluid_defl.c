@@ -64,11 +64,10 @@ enum mps_status fluid_defl_create(struct fluid_defl **out, int nthreads, int par
     }
     s->cm.print = 0; /* errors come back through err, not stderr */
     /* simplicial: no BLAS (see direct() in fluid_linsolve.c on OpenBLAS
-     * threads), and E is small and sparse; AMD alone, without trying other
-     * orderings */
+     * threads), and E is small and sparse; one ordering, without trying
+     * others: fluid_defl_setup picks AMD or E's own order (NATURAL_MAX_BW) */
     s->cm.supernodal = CHOLMOD_SIMPLICIAL;
     s->cm.nmethods = 1;
-    s->cm.method[0].ordering = CHOLMOD_AMD;
     *out = s;
     return MPS_OK;
 }
