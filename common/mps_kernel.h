@@ -5,9 +5,6 @@
 
 #include <math.h>
 #include <stddef.h>
-#ifdef __SSE2__
-#include <emmintrin.h>
-#endif
 
 #include "mps_dim.h"
 
@@ -29,29 +26,24 @@ static inline double mps_weight_r2(double r2, double re)
 
 /* mps_weight_r2 of n squared distances, in place, times scale. Kept apart
  * from the loops that gather the distances so that it runs over contiguous
- * values with packed square roots and divisions: one at a time, these
- * bound a neighbour loop (about 10 cycles a candidate). Written with SSE2
- * intrinsics because the compiler vectorises the plain loop only without
+ * values, packed: one at a time, the square roots and divisions bound a
+ * neighbour loop (about 10 cycles a candidate). Two paths, picked at run
+ * time by what the CPU has:
+ * - AVX-512F: 1/r from the hardware estimate (14 bits) and two Newton steps
+ *   with FMA, eight at a time; within a few units in the last place of
+ *   mps_weight_r2 (measured: tests/common/test_nbr.c), not the same bits.
+ *   The divider and square-root unit of recent x86 cores is no faster per
+ *   element at 256 or 512 bits than at 128, so wider sqrt/div would not help.
+ * - otherwise SSE2 (every x86-64), with the same bits as mps_weight_r2.
+ * Intrinsics, because the compiler vectorises the plain loop only without
  * errno from sqrt (-fno-math-errno), and that flag made the scalar square
- * roots elsewhere 6-7% slower (3.5 mm dam break, 2 threads). The same bits
- * as mps_weight_r2: max(w, 0) is 0.5 (w + |w|) for every w it meets (no
- * NaN: r^2 = 0 maps to infinity, w = -1). */
-static inline void mps_weights_r2(double *restrict w, size_t n, double re, double scale)
-{
-    size_t k = 0;
-#ifdef __SSE2__
-    const __m128d vre = _mm_set1_pd(re), vscale = _mm_set1_pd(scale), one = _mm_set1_pd(1.0),
-                  zero = _mm_setzero_pd(), inf = _mm_set1_pd(INFINITY);
-    for (; k + 2 <= n; k += 2) {
-        __m128d r2 = _mm_loadu_pd(w + k), pos = _mm_cmpgt_pd(r2, zero);
-        r2 = _mm_or_pd(_mm_and_pd(pos, r2), _mm_andnot_pd(pos, inf));
-        __m128d v = _mm_sub_pd(_mm_div_pd(vre, _mm_sqrt_pd(r2)), one);
-        _mm_storeu_pd(w + k, _mm_mul_pd(vscale, _mm_max_pd(v, zero)));
-    }
-#endif
-    for (; k < n; k++)
-        w[k] = scale * mps_weight_r2(w[k], re);
-}
+ * roots elsewhere 6-7% slower (3.5 mm dam break, 2 threads). */
+void mps_weights_r2(double *restrict w, size_t n, double re, double scale);
+
+/* The two paths of mps_weights_r2, for tests. mps_weights_r2_wide returns 0
+ * and does nothing when the CPU (or the build target) lacks AVX-512F. */
+void mps_weights_r2_sse2(double *restrict w, size_t n, double re, double scale);
+int mps_weights_r2_wide(double *restrict w, size_t n, double re, double scale);
 
 /* Neighbour loops that call mps_weights_r2 take their list in chunks of this
  * many candidates, with stack buffers of this size. */

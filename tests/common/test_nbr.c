@@ -1,5 +1,6 @@
 /* Neighbour search against brute force O(N^2), and the lattice constants of
  * the MPS weight against hand sums. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -372,9 +373,9 @@ static void test_kernel(void)
     }
     CHECK(same);
 
-    /* The packed form (mps_weights_r2) gives the same bits as the scalar
-     * one times the scale, for an odd count (the scalar tail runs too), with
-     * r = 0, r = re and r beyond re among them. */
+    /* The packed SSE2 form gives the same bits as the scalar one times the
+     * scale, for an odd count (the scalar tail runs too), with r = 0,
+     * r = re and r beyond re among them. */
     enum { NW = 2001 };
     static double w[NW], r2[NW];
     const double scale = 3.7;
@@ -383,12 +384,38 @@ static void test_kernel(void)
         r2[k] = w[k] = r * r;
     }
     r2[NW / 2] = w[NW / 2] = re * re;
-    mps_weights_r2(w, NW, re, scale);
+    mps_weights_r2_sse2(w, NW, re, scale);
     same = 1;
     for (int k = 0; k < NW; k++)
         same &= w[k] == scale * mps_weight_r2(r2[k], re);
     CHECK(same);
     CHECK(w[0] == 0.0 && w[NW / 2] == 0.0 && w[NW - 1] == 0.0 && w[1] > 0.0);
+
+    /* The AVX-512 form (1/r from a 14-bit estimate and two Newton steps) is
+     * within 4 units in the last place of re/r: w = re/r - 1 is then off by
+     * at most 4 eps re/r, far below the weights' own truncation error. One
+     * Newton step fewer would leave 2^-27 relative, which this catches. Zero
+     * where the scalar form is zero (r = 0 and r >= re, up to the same
+     * rounding at r = re). */
+    memcpy(w, r2, sizeof w);
+    if (mps_weights_r2_wide(w, NW, re, scale)) {
+        double worst = 0.0;
+        int zeros = 1;
+        for (int k = 0; k < NW; k++) {
+            double exact = scale * mps_weight_r2(r2[k], re);
+            if (r2[k] == 0.0 || r2[k] > re * re)
+                zeros &= w[k] == 0.0;
+            else {
+                double err = fabs(w[k] - exact) / (scale * re / sqrt(r2[k]) * DBL_EPSILON);
+                worst = err > worst ? err : worst;
+            }
+        }
+        printf("  AVX-512 weights: worst %.2f eps of re/r\n", worst);
+        CHECK(zeros);
+        CHECK(worst <= 4.0);
+        CHECK(w[1] > 0.0);
+    } else
+        printf("  AVX-512 weights: not on this CPU, SSE2 path only\n");
 }
 
 /* Lists that keep only j (no_r2, as the fluid's): the same pairs in the same
