@@ -144,14 +144,16 @@ static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, 
         double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])in->x, i, (size_t)j, dx);
         if (r2 >= re2 || r2 <= 0.0)
             continue;
-        double r = sqrt(r2), w = mps_weight(r, in->re);
-        double s = (f[j] - ref) * w / r2; /* (f_j-ref)/r * e * w = (f_j-ref) dx w / r^2 */
+        /* one division: w / r^2 = (re / r - 1) / r^2 from 1 / r. Divisions
+         * bound this loop (it had one per term of m). */
+        double ir = 1.0 / sqrt(r2), w = in->re * ir - 1.0, wr2 = w * ir * ir;
+        double s = (f[j] - ref) * wr2; /* (f_j-ref)/r * e * w = (f_j-ref) dx w / r^2 */
         for (int a = 0; a < MPS_DIM; a++)
             g[a] += s * dx[a];
         if (m)
             for (int a = 0; a < MPS_DIM; a++)
                 for (int b = 0; b < MPS_DIM; b++)
-                    m[a][b] += dx[a] * dx[b] / r2 * w;
+                    m[a][b] += dx[a] * dx[b] * wr2;
         wsum += w;
     }
     return wsum;
@@ -239,7 +241,8 @@ void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f
                 continue;
             for (int d = 0; d < MPS_DIM; d++)
                 dot += (f[j][d] - f[i][d]) * dx[d];
-            acc += dot / r2 * mps_weight(sqrt(r2), in->re);
+            double ir = 1.0 / sqrt(r2); /* one division, as in grad_sums */
+            acc += dot * ((in->re * ir - 1.0) * ir * ir);
         }
         div[i] = coef * acc;
     }

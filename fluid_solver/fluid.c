@@ -378,9 +378,11 @@ static void shift(struct fluid *f, double dt)
             double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
             if (r2 >= re2 || r2 <= 0.0)
                 continue;
-            double r = sqrt(r2), dw = re / r2; /* -w'(r) */
+            /* grad n_i = sum -w'(r) e_ij, -w'(r) = re / r^2 and e_ij = dx / r,
+             * from one division (divisions bound the loop) */
+            double ir = 1.0 / sqrt(r2), dw_r = re * ir * ir * ir;
             for (int d = 0; d < MPS_DIM; d++)
-                g[d] += dw * dx[d] / r; /* grad n_i = sum -w'(r) e_ij */
+                g[d] += dw_r * dx[d];
             near_surf |= f->is_fluid[j] && f->surface[j];
         }
         for (int d = 0; d < MPS_DIM; d++)
