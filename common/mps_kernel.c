@@ -1,10 +1,28 @@
 #include "mps_kernel.h"
 
 #include <math.h>
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define MPS_HAVE_WIDE 1
+#include <stdlib.h>
+#include <string.h>
+#ifdef MPS_HAVE_WIDE
 #include <immintrin.h>
 #endif
+
+static int simd_wide_found, simd_wide;
+
+/* Before main, so that the loops that ask never race on the answer. */
+__attribute__((constructor)) static void simd_init(void)
+{
+#ifdef MPS_HAVE_WIDE
+    const char *env = getenv("MPS_SIMD");
+    __builtin_cpu_init(); /* constructors may run before libgcc's own */
+    simd_wide_found = __builtin_cpu_supports("avx512f") && !(env && !strcmp(env, "sse2"));
+#endif
+    simd_wide = simd_wide_found;
+}
+
+int mps_simd_wide(void) { return simd_wide; }
+
+void mps_simd_set_wide(int on) { simd_wide = on ? simd_wide_found : 0; }
 
 struct mps_lattice_consts mps_lattice_consts(double l0, double re)
 {
@@ -79,7 +97,7 @@ __attribute__((target("avx512f"))) static void weights_avx512(double *restrict w
 int mps_weights_r2_wide(double *restrict w, size_t n, double re, double scale)
 {
 #ifdef MPS_HAVE_WIDE
-    if (__builtin_cpu_supports("avx512f")) {
+    if (simd_wide) {
         weights_avx512(w, n, re, scale);
         return 1;
     }

@@ -8,6 +8,21 @@
 
 #include "mps_dim.h"
 
+/* Builds that can carry AVX-512 paths picked at run time (GCC or Clang on
+ * x86-64); the paths run only where mps_simd_wide() says so. */
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define MPS_HAVE_WIDE 1
+#endif
+
+/* 1 when the AVX-512 paths run: the CPU has AVX-512F, and neither
+ * MPS_SIMD=sse2 in the environment (read at start-up) nor
+ * mps_simd_set_wide(0) turned them off. The portable paths give other last
+ * bits, so MPS_SIMD=sse2 reproduces a run of a machine without AVX-512. */
+int mps_simd_wide(void);
+/* 0: the portable paths from now on; 1: back to what mps_simd_wide found.
+ * For tests that compare the two; not thread-safe against running loops. */
+void mps_simd_set_wide(int on);
+
 /* Eq. 7: w(r) = re/r - 1 for 0 < r <= re, else 0. */
 static inline double mps_weight(double r, double re)
 {
@@ -41,7 +56,7 @@ static inline double mps_weight_r2(double r2, double re)
 void mps_weights_r2(double *restrict w, size_t n, double re, double scale);
 
 /* The two paths of mps_weights_r2, for tests. mps_weights_r2_wide returns 0
- * and does nothing when the CPU (or the build target) lacks AVX-512F. */
+ * and does nothing when mps_simd_wide() is 0. */
 void mps_weights_r2_sse2(double *restrict w, size_t n, double re, double scale);
 int mps_weights_r2_wide(double *restrict w, size_t n, double re, double scale);
 

@@ -415,7 +415,7 @@ static void test_kernel(void)
         CHECK(worst <= 4.0);
         CHECK(w[1] > 0.0);
     } else
-        printf("  AVX-512 weights: not on this CPU, SSE2 path only\n");
+        printf("  AVX-512 weights: not on this CPU (or MPS_SIMD=sse2), SSE2 path only\n");
 }
 
 /* Lists that keep only j (no_r2, as the fluid's): the same pairs in the same

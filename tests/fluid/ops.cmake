@@ -5,3 +5,8 @@ mps_add_test(test_fluid_ops SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ops.c
 mps_add_test(test_fluid_step SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_fluid_step.c
   LIBS fluidcore LABELS unit TIMEOUT 60)
 set_tests_properties(test_fluid_step PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=1")
+# The same known answers on the portable paths (MPS_SIMD=sse2), which an
+# AVX-512 machine otherwise runs only inside test_simd_paths.
+add_test(NAME test_fluid_step_portable COMMAND test_fluid_step WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(test_fluid_step_portable PROPERTIES ENVIRONMENT "OMP_NUM_THREADS=1;MPS_SIMD=sse2"
+  TIMEOUT 60 LABELS unit)
