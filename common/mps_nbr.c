@@ -5,6 +5,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mps_kernel.h" /* MPS_HAVE_WIDE, mps_simd_wide */
+#ifdef MPS_HAVE_WIDE
+#include <immintrin.h>
+#endif
+
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
 {
     if (need <= *cap)
@@ -149,9 +154,52 @@ static size_t candidates(const struct mps_nbr_grid *g, const struct cell_window 
  * candidates(g, w)) sorted by j and returns their number. Within a cell
  * particles are in index order; tmp (same room) holds these runs before
  * they are merged. */
+#ifdef MPS_HAVE_WIDE
+/* The candidate loop of visit() over slots k .. kend of one cell, eight at a
+ * time (mps_simd_wide): the kept j (and r2) packed by compress at jtmp (and
+ * r2tmp) + m; returns the new m. r2 is computed as in the scalar loop
+ * (products, then the sum; no FMA), so the list is the same, bit for bit. */
+__attribute__((target("avx512f"))) static size_t visit_cell_avx512(
+    const struct mps_nbr_grid *g, size_t k, size_t kend, double xi, double yi, size_t i,
+    double r2max, int *jtmp, double *r2tmp, int want_r2, size_t m)
+{
+    const __m512i even = _mm512_set_epi64(14, 12, 10, 8, 6, 4, 2, 0),
+                  odd = _mm512_set_epi64(15, 13, 11, 9, 7, 5, 3, 1),
+                  vi = _mm512_set1_epi64((long long)i);
+    const __m512d vxi = _mm512_set1_pd(xi), vyi = _mm512_set1_pd(yi), vr2 = _mm512_set1_pd(r2max);
+    for (; k < kend; k += 8) {
+        const size_t left = kend - k;
+        const __mmask8 in = left >= 8 ? 0xFF : (__mmask8)((1u << left) - 1u);
+        /* the interleaved x, y of the eight: 16 doubles, the tail masked */
+        const __mmask8 in_lo = left >= 4 ? 0xFF : (__mmask8)((1u << (2 * left)) - 1u),
+                       in_hi = left >= 8 ? 0xFF
+                               : left > 4 ? (__mmask8)((1u << (2 * (left - 4))) - 1u)
+                                          : 0;
+        const __m512d lo = _mm512_maskz_loadu_pd(in_lo, &g->xs[k][0]),
+                      hi = _mm512_maskz_loadu_pd(in_hi, &g->xs[k][0] + 8);
+        const __m512d dx = _mm512_sub_pd(_mm512_permutex2var_pd(lo, even, hi), vxi),
+                      dy = _mm512_sub_pd(_mm512_permutex2var_pd(lo, odd, hi), vyi);
+        const __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+        const __m512i j = _mm512_maskz_loadu_epi64(in, g->sorted + k);
+        const __mmask8 keep = _mm512_cmp_pd_mask(r2, vr2, _CMP_LT_OQ) &
+                              _mm512_cmpneq_epi64_mask(j, vi) & in;
+        const int nk = __builtin_popcount(keep);
+        const __mmask16 first = (__mmask16)((1u << nk) - 1u);
+        _mm512_mask_storeu_epi32(
+            jtmp + m, first,
+            _mm512_maskz_compress_epi32((__mmask16)keep,
+                                        _mm512_castsi256_si512(_mm512_cvtepi64_epi32(j))));
+        if (want_r2)
+            _mm512_mask_storeu_pd(r2tmp + m, (__mmask8)first, _mm512_maskz_compress_pd(keep, r2));
+        m += (size_t)nk;
+    }
+    return m;
+}
+#endif
+
 static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], size_t i,
                     const struct cell_window *w, double r2max, int *jout, double *r2out,
-                    int *jtmp, double *r2tmp, const int want_r2)
+                    int *jtmp, double *r2tmp, const int want_r2, const int wide)
 {
     const double xi = x[i][0], yi = x[i][1];
     size_t runs[3 * 3 + 1], nruns = 0, m = 0;
@@ -160,8 +208,13 @@ static size_t visit(const struct mps_nbr_grid *g, const double (*x)[MPS_DIM], si
         size_t row = (size_t)b * (size_t)g->dims[0];
         for (int a = w->a0; a <= w->a1; a++) {
             /* one run per cell: sorted by index within the cell */
-            for (size_t k = g->cell_start[row + (size_t)a]; k < g->cell_start[row + (size_t)a + 1];
-                 k++) {
+            const size_t k0 = g->cell_start[row + (size_t)a], k1 = g->cell_start[row + (size_t)a + 1];
+#ifdef MPS_HAVE_WIDE
+            if (wide)
+                m = visit_cell_avx512(g, k0, k1, xi, yi, i, r2max, jtmp, r2tmp, want_r2, m);
+            else
+#endif
+            for (size_t k = k0; k < k1; k++) {
                 double dx = g->xs[k][0] - xi, dy = g->xs[k][1] - yi;
                 double r2 = dx * dx + dy * dy;
                 size_t j = g->sorted[k];
@@ -303,7 +356,7 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
     /* Threads take contiguous blocks with equal numbers of queried rows: a
      * fluid queries its first particles only, and an even split by index
      * gave one thread nearly all the work. */
-    const int ntmax = omp_get_max_threads();
+    const int ntmax = omp_get_max_threads(), wide = mps_simd_wide();
     if (reserve_scratch(l, ntmax))
         return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory");
     size_t *bound = malloc(((size_t)ntmax + 1) * sizeof *bound);
@@ -344,8 +397,8 @@ enum mps_status mps_nbr_list_build_masked(struct mps_nbr_list *l, const struct m
                     break;
                 }
                 m = want_r2 ? visit(g, x, i, &w, r2max, sc->jb + used, sc->rb + used, sc->jt,
-                                    sc->rt, 1)
-                            : visit(g, x, i, &w, r2max, sc->jb + used, NULL, sc->jt, NULL, 0);
+                                    sc->rt, 1, wide)
+                            : visit(g, x, i, &w, r2max, sc->jb + used, NULL, sc->jt, NULL, 0, wide);
             }
             l->start[i + 1] = m;
             used += m;
