@@ -436,6 +436,43 @@ static size_t even_split(const struct mps_nbr_list *src, int t, int nt)
  * block of rows into its own buffer, then copies them to their place once
  * the row offsets are known (rather than counting in one pass and writing
  * in a second, which reads every candidate and its position twice). */
+#ifdef MPS_HAVE_WIDE
+/* The loop of mps_nbr_list_filter over one row's candidates j[0 .. len),
+ * eight at a time (mps_simd_wide): positions gathered, r2 as
+ * mps_pair_delta computes it (same bits), r2 stored to src_r2 if given, the
+ * kept j (and r2, if dst_r2) packed at jout (and r2out); returns their
+ * number. */
+__attribute__((target("avx512f"))) static size_t filter_row_avx512(
+    const int *j, size_t len, const double (*x)[MPS_DIM], size_t i, double r2max,
+    double *src_r2, int *jout, double *r2out)
+{
+    const double *xd = &x[0][0];
+    const __m512d vxi = _mm512_set1_pd(x[i][0]), vyi = _mm512_set1_pd(x[i][1]),
+                  vr2 = _mm512_set1_pd(r2max);
+    size_t m = 0;
+    for (size_t k = 0; k < len; k += 8) {
+        const __mmask8 in = len - k >= 8 ? 0xFF : (__mmask8)((1u << (len - k)) - 1u);
+        const __m512i jv = _mm512_maskz_loadu_epi32(in, j + k);
+        const __m256i j2 = _mm256_slli_epi32(_mm512_castsi512_si256(jv), 1); /* x[j][0] at 2j */
+        const __m512d dx = _mm512_sub_pd(
+                          _mm512_mask_i32gather_pd(_mm512_setzero_pd(), in, j2, xd, 8), vxi),
+                      dy = _mm512_sub_pd(
+                          _mm512_mask_i32gather_pd(_mm512_setzero_pd(), in, j2, xd + 1, 8), vyi);
+        const __m512d r2 = _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy));
+        if (src_r2)
+            _mm512_mask_storeu_pd(src_r2 + k, in, r2);
+        const __mmask8 keep = _mm512_cmp_pd_mask(r2, vr2, _CMP_LT_OQ) & in;
+        const int nk = __builtin_popcount(keep);
+        const __mmask16 first = (__mmask16)((1u << nk) - 1u);
+        _mm512_mask_storeu_epi32(jout + m, first, _mm512_maskz_compress_epi32((__mmask16)keep, jv));
+        if (r2out)
+            _mm512_mask_storeu_pd(r2out + m, (__mmask8)first, _mm512_maskz_compress_pd(keep, r2));
+        m += (size_t)nk;
+    }
+    return m;
+}
+#endif
+
 enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_list *src,
                                     const double (*x)[MPS_DIM], double radius,
                                     struct mps_err *err)
@@ -449,7 +486,7 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
     dst->n = n;
     dst->radius = radius;
     dst->start[0] = 0;
-    const int src_r2 = !src->no_r2, dst_r2 = !dst->no_r2;
+    const int src_r2 = !src->no_r2, dst_r2 = !dst->no_r2, wide = mps_simd_wide();
     int fail = 0;
 #pragma omp parallel num_threads(ntmax)
     {
@@ -462,6 +499,17 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
         size_t used = 0;
         if (!lfail)
             for (size_t i = lo; i < hi; i++) {
+#ifdef MPS_HAVE_WIDE
+                if (wide) {
+                    const size_t k0 = src->start[i], m =
+                        filter_row_avx512(src->j + k0, src->start[i + 1] - k0, x, i, r2max,
+                                          src_r2 ? src->r2 + k0 : NULL, sc->jb + used,
+                                          dst_r2 ? sc->rb + used : NULL);
+                    dst->start[i + 1] = m;
+                    used += m;
+                    continue;
+                }
+#endif
                 /* every candidate is written, kept by advancing the count
                  * (which pass follows no order a predictor could learn) */
                 size_t m = used;
