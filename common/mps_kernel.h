@@ -8,21 +8,6 @@
 
 #include "mps_dim.h"
 
-/* Builds that can carry AVX-512 paths picked at run time (GCC or Clang on
- * x86-64); the paths run only where mps_simd_wide() says so. */
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-#define MPS_HAVE_WIDE 1
-#endif
-
-/* 1 when the AVX-512 paths run: the CPU has AVX-512F, and neither
- * MPS_SIMD=sse2 in the environment (read at start-up) nor
- * mps_simd_set_wide(0) turned them off. The portable paths give other last
- * bits, so MPS_SIMD=sse2 reproduces a run of a machine without AVX-512. */
-int mps_simd_wide(void);
-/* 0: the portable paths from now on; 1: back to what mps_simd_wide found.
- * For tests that compare the two; not thread-safe against running loops. */
-void mps_simd_set_wide(int on);
-
 /* Eq. 7: w(r) = re/r - 1 for 0 < r <= re, else 0. */
 static inline double mps_weight(double r, double re)
 {
@@ -42,17 +27,12 @@ static inline double mps_weight_r2(double r2, double re)
 /* mps_weight_r2 of n squared distances, in place, times scale. Kept apart
  * from the loops that gather the distances so that it runs over contiguous
  * values, packed: one at a time, the square roots and divisions bound a
- * neighbour loop (about 10 cycles a candidate). Two paths, picked at run
- * time by what the CPU has:
- * - AVX-512F: 1/r from the hardware estimate (14 bits) and two Newton steps
- *   with FMA, eight at a time; within a few units in the last place of
- *   mps_weight_r2 (measured: tests/common/test_nbr.c), not the same bits.
- *   The divider and square-root unit of recent x86 cores is no faster per
- *   element at 256 or 512 bits than at 128, so wider sqrt/div would not help.
- * - otherwise SSE2 (every x86-64), with the same bits as mps_weight_r2.
- * Intrinsics, because the compiler vectorises the plain loop only without
- * errno from sqrt (-fno-math-errno), and that flag made the scalar square
- * roots elsewhere 6-7% slower (3.5 mm dam break, 2 threads). */
+ * neighbour loop (about 10 cycles a candidate). Eight at a time with
+ * mps_weight8_r2 where mps_simd_wide() (within a few units in the last
+ * place), else SSE2 with the same bits as mps_weight_r2. Intrinsics,
+ * because the compiler vectorises the plain loop only without errno from
+ * sqrt (-fno-math-errno), and that flag made the scalar square roots
+ * elsewhere 6-7% slower (3.5 mm dam break, 2 threads). */
 void mps_weights_r2(double *restrict w, size_t n, double re, double scale);
 
 /* The two paths of mps_weights_r2, for tests. mps_weights_r2_wide returns 0

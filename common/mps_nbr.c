@@ -5,10 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "mps_kernel.h" /* MPS_HAVE_WIDE, mps_simd_wide */
-#ifdef MPS_HAVE_WIDE
-#include <immintrin.h>
-#endif
+#include "mps_simd.h"
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
 {
@@ -169,12 +166,9 @@ __attribute__((target("avx512f"))) static size_t visit_cell_avx512(
     const __m512d vxi = _mm512_set1_pd(xi), vyi = _mm512_set1_pd(yi), vr2 = _mm512_set1_pd(r2max);
     for (; k < kend; k += 8) {
         const size_t left = kend - k;
-        const __mmask8 in = left >= 8 ? 0xFF : (__mmask8)((1u << left) - 1u);
+        const __mmask8 in = mps_lanes8(left);
         /* the interleaved x, y of the eight: 16 doubles, the tail masked */
-        const __mmask8 in_lo = left >= 4 ? 0xFF : (__mmask8)((1u << (2 * left)) - 1u),
-                       in_hi = left >= 8 ? 0xFF
-                               : left > 4 ? (__mmask8)((1u << (2 * (left - 4))) - 1u)
-                                          : 0;
+        const __mmask8 in_lo = mps_lanes8(2 * left), in_hi = left > 4 ? mps_lanes8(2 * (left - 4)) : 0;
         const __m512d lo = _mm512_maskz_loadu_pd(in_lo, &g->xs[k][0]),
                       hi = _mm512_maskz_loadu_pd(in_hi, &g->xs[k][0] + 8);
         const __m512d dx = _mm512_sub_pd(_mm512_permutex2var_pd(lo, even, hi), vxi),
@@ -184,7 +178,7 @@ __attribute__((target("avx512f"))) static size_t visit_cell_avx512(
         const __mmask8 keep = _mm512_cmp_pd_mask(r2, vr2, _CMP_LT_OQ) &
                               _mm512_cmpneq_epi64_mask(j, vi) & in;
         const int nk = __builtin_popcount(keep);
-        const __mmask16 first = (__mmask16)((1u << nk) - 1u);
+        const __mmask16 first = mps_lanes8((size_t)nk);
         _mm512_mask_storeu_epi32(
             jtmp + m, first,
             _mm512_maskz_compress_epi32((__mmask16)keep,
@@ -451,7 +445,7 @@ __attribute__((target("avx512f"))) static size_t filter_row_avx512(
                   vr2 = _mm512_set1_pd(r2max);
     size_t m = 0;
     for (size_t k = 0; k < len; k += 8) {
-        const __mmask8 in = len - k >= 8 ? 0xFF : (__mmask8)((1u << (len - k)) - 1u);
+        const __mmask8 in = mps_lanes8(len - k);
         const __m512i jv = _mm512_maskz_loadu_epi32(in, j + k);
         const __m256i j2 = _mm256_slli_epi32(_mm512_castsi512_si256(jv), 1); /* x[j][0] at 2j */
         const __m512d dx = _mm512_sub_pd(
@@ -463,7 +457,7 @@ __attribute__((target("avx512f"))) static size_t filter_row_avx512(
             _mm512_mask_storeu_pd(src_r2 + k, in, r2);
         const __mmask8 keep = _mm512_cmp_pd_mask(r2, vr2, _CMP_LT_OQ) & in;
         const int nk = __builtin_popcount(keep);
-        const __mmask16 first = (__mmask16)((1u << nk) - 1u);
+        const __mmask16 first = mps_lanes8((size_t)nk);
         _mm512_mask_storeu_epi32(jout + m, first, _mm512_maskz_compress_epi32((__mmask16)keep, jv));
         if (r2out)
             _mm512_mask_storeu_pd(r2out + m, (__mmask8)first, _mm512_maskz_compress_pd(keep, r2));

@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "mps_kernel.h"
+#include "mps_simd.h"
 
 #define USE(in, j) (!(in)->use || (in)->use[j])
 #define QUERY(in, i) (!(in)->query || (in)->query[i])
@@ -37,16 +38,66 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
     }
 }
 
+#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+/* The sums of mps_ops_laplacian_vec for row i, eight candidates at a time
+ * (mps_simd_wide): positions and field gathered, weights by mps_weight8_r2,
+ * the use mask from one byte per candidate. */
+__attribute__((target("avx512f"))) static void laplacian_vec_row_avx512(
+    const struct mps_ops_in *in, size_t i, const double (*f)[2], double acc[2])
+{
+    const struct mps_nbr_list *nl = in->nl;
+    const int *nj = nl->j + nl->start[i];
+    const size_t len = nl->start[i + 1] - nl->start[i];
+    const double *xd = &in->x[0][0], *fd = &f[0][0];
+    const __m512d vxi = _mm512_set1_pd(in->x[i][0]), vyi = _mm512_set1_pd(in->x[i][1]),
+                  vfx = _mm512_set1_pd(f[i][0]), vfy = _mm512_set1_pd(f[i][1]),
+                  vre = _mm512_set1_pd(in->re), zero = _mm512_setzero_pd();
+    __m512d ax = zero, ay = zero;
+    for (size_t k = 0; k < len; k += 8) {
+        const __mmask8 lanes = mps_lanes8(len - k);
+        __mmask8 use = lanes;
+        if (in->use) {
+            use = 0;
+            for (size_t l = 0; l < 8 && k + l < len; l++)
+                use |= (__mmask8)((in->use[nj[k + l]] != 0) << l);
+        }
+        const __m256i j2 = _mm256_slli_epi32(
+            _mm512_castsi512_si256(_mm512_maskz_loadu_epi32(lanes, nj + k)), 1);
+        const __m512d dx = _mm512_sub_pd(_mm512_mask_i32gather_pd(zero, lanes, j2, xd, 8), vxi),
+                      dy = _mm512_sub_pd(_mm512_mask_i32gather_pd(zero, lanes, j2, xd + 1, 8), vyi);
+        const __m512d w =
+            mps_weight8_r2(_mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)), vre);
+        const __m512d gx = _mm512_sub_pd(_mm512_mask_i32gather_pd(vfx, use, j2, fd, 8), vfx),
+                      gy = _mm512_sub_pd(_mm512_mask_i32gather_pd(vfy, use, j2, fd + 1, 8), vfy);
+        ax = _mm512_fmadd_pd(gx, w, ax); /* f_j - f_i = 0 where not used */
+        ay = _mm512_fmadd_pd(gy, w, ay);
+    }
+    acc[0] = _mm512_reduce_add_pd(ax);
+    acc[1] = _mm512_reduce_add_pd(ay);
+}
+#endif
+
 void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda,
                            const double (*f)[MPS_DIM], double (*lap)[MPS_DIM])
 {
     const struct mps_nbr_list *nl = in->nl;
     const double coef = 2.0 * MPS_DIM / (lambda * n0);
+#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+    const int wide = mps_simd_wide();
+#endif
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
         double acc[MPS_DIM] = {0}, w[MPS_WEIGHT_CHUNK];
+#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+        if (wide) {
+            laplacian_vec_row_avx512(in, i, f, acc);
+            for (int d = 0; d < MPS_DIM; d++)
+                lap[i][d] = coef * acc[d];
+            continue;
+        }
+#endif
         /* in chunks: distances, weights packed (mps_weights_r2), sums */
         for (size_t c0 = nl->start[i]; c0 < nl->start[i + 1]; c0 += MPS_WEIGHT_CHUNK) {
             const size_t len = nl->start[i + 1] - c0 < MPS_WEIGHT_CHUNK ? nl->start[i + 1] - c0

@@ -5,9 +5,7 @@
 #include <stdlib.h>
 
 #include "mps_kernel.h"
-#ifdef MPS_HAVE_WIDE
-#include <immintrin.h>
-#endif
+#include "mps_simd.h"
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
 {
@@ -106,7 +104,7 @@ __attribute__((target("avx512f"))) static void pass1_chunk_avx512(
     __m512d dsum = zero, mom0 = zero, mom1 = zero, srf0 = zero, srf1 = zero, ws = zero;
     int m = 0, q = a->q;
     for (size_t k = 0; k < len; k += 8) {
-        const __mmask8 in = len - k >= 8 ? 0xFF : (__mmask8)((1u << (len - k)) - 1u);
+        const __mmask8 in = mps_lanes8(len - k);
         /* flags and indices: 32-bit lanes, the low eight used */
         const __m512i fl = _mm512_maskz_loadu_epi32(in, fb + k), j = _mm512_maskz_loadu_epi32(in, nj + k);
         const __m512d dx = _mm512_maskz_loadu_pd(in, bx + k), dy = _mm512_maskz_loadu_pd(in, by + k);
@@ -123,7 +121,7 @@ __attribute__((target("avx512f"))) static void pass1_chunk_avx512(
         ws = _mm512_add_pd(ws, cs);
         const __mmask8 keep = _mm512_cmp_pd_mask(cw, zero, _CMP_GT_OQ);
         const int nk = __builtin_popcount(keep);
-        const __mmask8 first = (__mmask8)((1u << nk) - 1u);
+        const __mmask8 first = mps_lanes8((size_t)nk);
         _mm512_mask_storeu_pd(wlap + q, first, _mm512_maskz_compress_pd(keep, cw));
         _mm512_mask_storeu_epi32(wcol + q, first, _mm512_maskz_compress_epi32(keep, j));
         q += nk;

@@ -8,6 +8,7 @@
 
 #include "../test_util.h"
 #include "mps_kernel.h"
+#include "mps_simd.h"
 #include "mps_nbr.h"
 #include "mps_particles.h"
 

@@ -19,6 +19,7 @@
 #include "fluid_ppe.h"
 #include "mps_case.h"
 #include "mps_kernel.h"
+#include "mps_simd.h"
 
 static struct fluid *make(const char *path, const char **sets, int nsets)
 {
