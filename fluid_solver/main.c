@@ -18,6 +18,7 @@
 #include "mps_omp.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
+#include "mps_simd.h"
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_solver.h"
@@ -88,6 +89,8 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
     }
     if (r->cpu_note[0])
         mps_json_str(&j, "cpu_binding", r->cpu_note);
+    /* the vector paths set the last bits of the results (MPS_SIMD=sse2) */
+    mps_json_str(&j, "simd_paths", mps_simd_wide() ? "avx512" : "portable");
     if (r->f)
         fluid_summary(r->f, &j);
     mps_json_end(&j);

@@ -45,3 +45,8 @@ add_test(NAME fluid_cpu_binding
           -P ${FV_DIR}/scripts/check_binding.cmake
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(fluid_cpu_binding PROPERTIES LABELS integration TIMEOUT 60)
+add_test(NAME fluid_simd_paths
+  COMMAND ${CMAKE_COMMAND} -DSOLVER=${FV_SOLVER} -DOUT=${FV_OUT}/simd
+          -P ${FV_DIR}/scripts/check_simd.cmake
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_simd_paths PROPERTIES LABELS integration TIMEOUT 60)
