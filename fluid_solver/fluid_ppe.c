@@ -23,28 +23,6 @@ static int grow(void **p, size_t *cap, size_t need, size_t elem)
 /* ppe_flag bits: what pass 1 needs to know of a neighbour, one load */
 enum { PPE_F_UNKNOWN = 1, PPE_F_GHOST = 2, PPE_F_SURFACE_FLUID = 4, PPE_F_ROW = 8 };
 
-/* Pass 1 for row particle i: packs the Laplacian neighbours that enter row i
- * (nonzero weight) at the front of its range of the list, their index in
- * f->wcol and c w_ij in f->wlap; returns their number in *nw, the number of
- * unknown neighbours, and the diagonal in *diag.
- * Paper walls (4.3): the neighbours that carry a pressure (fluid, wall, solid
- * surface); dummy particles are left out.
- * Neumann walls: fluid neighbours enter as unknowns (or P = 0 on the free
- * surface); boundary neighbours (wall, dummy, solid) take the pressure
- * P_j = P_i + rho g.(x_j - x_i), so their P_i - P_j is known and goes to
- * the right-hand side (pass 2), not to the diagonal.
- * solid_ppe: the solid surface as in the paper, the tank as with Neumann
- * walls. f->unknown and f->ghost (fluid_update_masks) hold who is which.
- * The loop has no data-dependent branch: a third of the skin list lies
- * beyond re, in an order the branch predictor cannot learn, so every
- * candidate is computed, masked and written, the write position advancing
- * only for kept ones; pass 2 then walks only the kept ones. Measured on the
- * 3 mm dam break, 2 threads: 1.60 to 1.52 ms per step for the assembly
- * (the same branch-free weight took the viscous Laplacian from 1.00 to
- * 0.65 ms). The weights are then computed apart, packed (mps_weights_r2):
- * 3.5 mm dam break, 2 threads, 1.05 to 0.82 ms. With AVX-512 the masks,
- * sums and packing go eight at a time (pass1_chunk_avx512): 0.76 to
- * 0.61 ms. */
 /* Sums of pass 1 over a row's candidates (see row_weights). */
 struct pass1_acc {
     double dsum, mom[2], srf[2], ws;
@@ -137,6 +115,28 @@ __attribute__((target("avx512f"))) static void pass1_chunk_avx512(
 }
 #endif
 
+/* Pass 1 for row particle i: packs the Laplacian neighbours that enter row i
+ * (nonzero weight) at the front of its range of the list, their index in
+ * f->wcol and c w_ij in f->wlap; returns their number in *nw, the number of
+ * unknown neighbours, and the diagonal in *diag.
+ * Paper walls (4.3): the neighbours that carry a pressure (fluid, wall, solid
+ * surface); dummy particles are left out.
+ * Neumann walls: fluid neighbours enter as unknowns (or P = 0 on the free
+ * surface); boundary neighbours (wall, dummy, solid) take the pressure
+ * P_j = P_i + rho g.(x_j - x_i), so their P_i - P_j is known and goes to
+ * the right-hand side (pass 2), not to the diagonal.
+ * solid_ppe: the solid surface as in the paper, the tank as with Neumann
+ * walls. f->unknown and f->ghost (fluid_update_masks) hold who is which.
+ * The loop has no data-dependent branch: a third of the skin list lies
+ * beyond re, in an order the branch predictor cannot learn, so every
+ * candidate is computed, masked and written, the write position advancing
+ * only for kept ones; pass 2 then walks only the kept ones. Measured on the
+ * 3 mm dam break, 2 threads: 1.60 to 1.52 ms per step for the assembly
+ * (the same branch-free weight took the viscous Laplacian from 1.00 to
+ * 0.65 ms). The weights are then computed apart, packed (mps_weights_r2):
+ * 3.5 mm dam break, 2 threads, 1.05 to 0.82 ms. With AVX-512 the masks,
+ * sums and packing go eight at a time (pass1_chunk_avx512): 0.76 to
+ * 0.61 ms. */
 static int row_weights(struct fluid *f, size_t i, double c, int wide, double *diag, int *nw)
 {
     const double re = f->prm.re_lap * f->prm.dp;
