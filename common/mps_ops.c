@@ -87,6 +87,7 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
 #endif
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
+        mps_nbr_prefetch_row(nl, nl->j, sizeof *nl->j, i + MPS_NBR_PREFETCH_ROWS);
         if (!QUERY(in, i))
             continue;
         double acc[MPS_DIM] = {0}, w[MPS_WEIGHT_CHUNK];

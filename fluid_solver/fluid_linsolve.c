@@ -444,6 +444,8 @@ static inline double row_dot(const struct fluid_csr *A, int i, const double *v)
     double a0 = 0.0, a1 = 0.0, a2 = 0.0, a3 = 0.0;
     int k = A->rowptr[i];
     for (; k + 4 <= hi; k += 4) {
+        __builtin_prefetch(val + k + 256);
+        __builtin_prefetch(col + k + 256);
         a0 += val[k] * v[col[k]];
         a1 += val[k + 1] * v[col[k + 1]];
         a2 += val[k + 2] * v[col[k + 2]];
