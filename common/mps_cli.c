@@ -8,6 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "mps_simd.h"
 #include "mps_version.h"
 
 static void print_help(const char *usage, const struct mps_cli_extra *extra, int nextra)
@@ -139,7 +140,7 @@ enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
     }
     if (!cli->case_path)
         return mps_err_set(err, MPS_EINPUT, "missing case file (see --help)");
-    return MPS_OK;
+    return mps_simd_check_env(err);
 }
 
 /* mkdir that accepts an existing directory. */

@@ -6,6 +6,8 @@
 
 #include <stddef.h>
 
+#include "mps_err.h"
+
 /* Builds that can carry AVX-512 paths (GCC or Clang on x86-64). */
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #define MPS_HAVE_WIDE 1
@@ -17,6 +19,11 @@
  * mps_simd_set_wide(0) turned them off. The portable paths give other last
  * bits, so MPS_SIMD=sse2 reproduces a run of a machine without AVX-512. */
 int mps_simd_wide(void);
+/* MPS_SIMD as read at start-up: unset, empty, "auto" or "sse2" is MPS_OK;
+ * any other value is MPS_EINPUT naming it, so that a misspelt request for
+ * the portable paths cannot run the vector ones unnoticed. Every program
+ * checks it with its command line (mps_cli_parse). */
+enum mps_status mps_simd_check_env(struct mps_err *err);
 /* 0: the portable paths from now on; 1: back to what mps_simd_wide found.
  * For tests that compare the two; not thread-safe against running loops. */
 void mps_simd_set_wide(int on);

@@ -34,3 +34,11 @@ fluid_expect_fail(coupler_bad_no_scene "neither a fluid .* nor a solid"
 # resolved copy the solvers read
 fluid_expect_fail(coupler_bad_block_outside "coupler: --set fluid.blocks.0.x1=0.7: fluid.blocks.0.x1 = 0.7: the water block lies outside the tank"
                   ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set fluid.blocks.0.x1=0.7)
+# An unknown MPS_SIMD (a misspelt request for the portable paths) is refused
+# by every program, the coupler first.
+fluid_expect_fail(coupler_bad_simd_env "coupler: environment: MPS_SIMD=sse4: unknown value"
+                  ${CMAKE_COMMAND} -E env MPS_SIMD=sse4 ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT}
+                  --set dp=0.01 --set end_time=0.001)
+fluid_expect_fail(fluid_bad_simd_env "fluid_solver: environment: MPS_SIMD=sse4: unknown value"
+                  ${CMAKE_COMMAND} -E env MPS_SIMD=sse4 ${FS} ${DB} ${OUT}
+                  --set dp=0.01 --set end_time=0.001)
