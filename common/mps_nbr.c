@@ -493,7 +493,7 @@ enum mps_status mps_nbr_list_filter(struct mps_nbr_list *dst, struct mps_nbr_lis
         size_t used = 0;
         if (!lfail)
             for (size_t i = lo; i < hi; i++) {
-                mps_nbr_prefetch_row(src, src->j, sizeof *src->j, i + MPS_NBR_PREFETCH_ROWS);
+                mps_nbr_prefetch_row(src, i + MPS_NBR_PREFETCH_ROWS);
 #ifdef MPS_HAVE_WIDE
                 if (wide) {
                     const size_t k0 = src->start[i], m =

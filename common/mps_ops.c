@@ -5,6 +5,11 @@
 #include "mps_kernel.h"
 #include "mps_simd.h"
 
+/* the AVX-512 operator paths are written for 2D */
+#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+#define OPS_WIDE 1
+#endif
+
 #define USE(in, j) (!(in)->use || (in)->use[j])
 #define QUERY(in, i) (!(in)->query || (in)->query[i])
 
@@ -38,7 +43,7 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
     }
 }
 
-#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+#ifdef OPS_WIDE
 /* The sums of mps_ops_laplacian_vec for row i, eight candidates at a time
  * (mps_simd_wide): positions and field gathered, weights by mps_weight8_r2,
  * the use mask from one byte per candidate. */
@@ -82,16 +87,16 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
 {
     const struct mps_nbr_list *nl = in->nl;
     const double coef = 2.0 * MPS_DIM / (lambda * n0);
-#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+#ifdef OPS_WIDE
     const int wide = mps_simd_wide();
 #endif
 #pragma omp parallel for schedule(dynamic, 64)
     for (size_t i = 0; i < nl->n; i++) {
-        mps_nbr_prefetch_row(nl, nl->j, sizeof *nl->j, i + MPS_NBR_PREFETCH_ROWS);
+        mps_nbr_prefetch_row(nl, i + MPS_NBR_PREFETCH_ROWS);
         if (!QUERY(in, i))
             continue;
         double acc[MPS_DIM] = {0}, w[MPS_WEIGHT_CHUNK];
-#if defined(MPS_HAVE_WIDE) && MPS_DIM == 2
+#ifdef OPS_WIDE
         if (wide) {
             laplacian_vec_row_avx512(in, i, f, acc);
             for (int d = 0; d < MPS_DIM; d++)
