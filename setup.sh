@@ -3,6 +3,7 @@
 # something is missing) and builds everything in build/ (Release).
 #   ./setup.sh            install what is missing, configure, build
 #   ./setup.sh --debug    same, Debug with address/undefined sanitizers in build-debug/
+# MPS_WERROR=ON makes compiler warnings errors (CI sets it).
 set -eu
 cd "$(dirname "$0")"
 
@@ -23,9 +24,10 @@ if [ -n "$missing" ]; then
 fi
 
 if [ "${1:-}" = "--debug" ]; then
-    cmake -S . -B build-debug -DCMAKE_BUILD_TYPE=Debug -DMPS_SANITIZE=ON
+    cmake -S . -B build-debug -DCMAKE_BUILD_TYPE=Debug -DMPS_SANITIZE=ON \
+        -DMPS_WERROR="${MPS_WERROR:-OFF}"
     cmake --build build-debug -j"$(nproc)"
 else
-    cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
+    cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMPS_WERROR="${MPS_WERROR:-OFF}"
     cmake --build build -j"$(nproc)"
 fi
