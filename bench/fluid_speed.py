@@ -2,14 +2,16 @@
 """Fluid solver speed: time per particle-step and its split, as N grows.
 
 usage: bench/fluid_speed.py [--bin build/bin] [--threads 1,2] [--out docs/fluid_speed.md]
-Runs the dam break (cases/dambreak) at spacings that give about 6k, 20k and
-80k particles (fluid + wall + dummy) over the first 0.08 s of simulated time, once
-per thread count, and tabulates ns per particle-step by phase from each run's
-summary.json; each of these rows is the fastest of --repeat runs (3: a
-run of 80 steps at 6k particles varies by 10-15% from run to run here).
+Runs the dam break (cases/dambreak) at spacings that give about 6k, 20k, 80k
+and 290k particles (fluid + wall + dummy) over the first 0.08 s of simulated
+time, once per thread count, and tabulates ns per particle-step by phase from
+each run's summary.json; each of these rows is the fastest of --repeat runs (3:
+a run of 80 steps at 6k particles varies by 10-15% from run to run here). Then
+the growth of the cost per particle-step from size to size, against N log N's.
 Also times the paper's coarsest dam break (dp = 3 mm, 4,656
 fluid particles) over 1 s of simulated time, with the case's time step and
-with the solver's defaults. Run it on a quiet machine."""
+with the solver's defaults. Run it on a quiet machine: about 28 minutes on
+2 cores, most of it the 290k runs (--sizes 0.0035,0.0018,0.0008 leaves them out)."""
 import argparse, os, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -39,12 +41,30 @@ def case_time_step():
     return ', '.join(parts)
 
 
+def growth_table(per_size):
+    """Markdown lines: the cost per particle-step of each size over the
+    previous size's, next to N log N's (log N2 / log N1 per particle)."""
+    import math
+    out = ['', 'Growth of the cost per particle-step from each size to the next, against '
+           'N log N (whose cost per particle-step grows as log N):', '',
+           '| from N | to N | threads | measured | N log N |', '|---|---|---|---|---|']
+    for t, rows in per_size.items():
+        for (n1, c1), (n2, c2) in zip(rows, rows[1:]):
+            out.append(f'| {n1} | {n2} | {t} | {c2 / c1:.2f}x | '
+                       f'{math.log(n2) / math.log(n1):.2f}x |')
+        if len(rows) > 2:
+            (n1, c1), (n2, c2) = rows[0], rows[-1]
+            out.append(f'| {n1} | {n2} | {t} | {c2 / c1:.2f}x | '
+                       f'{math.log(n2) / math.log(n1):.2f}x |')
+    return out
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--bin', default=os.path.join(ROOT, 'build', 'bin'))
     ap.add_argument('--threads', default='1,2')
     ap.add_argument('--out', default=os.path.join(ROOT, 'docs', 'fluid_speed.md'))
-    ap.add_argument('--sizes', default='0.0035,0.0018,0.0008')
+    ap.add_argument('--sizes', default='0.0035,0.0018,0.0008,0.0004')
     ap.add_argument('--repeat', type=int, default=3)
     args = ap.parse_args()
     threads = [int(t) for t in args.threads.split(',')]
@@ -57,6 +77,7 @@ def main():
              '| dp (mm) | N | threads | steps | PPE iters/step | ' + ' | '.join(phases) +
              ' | total ns/particle-step |',
              '|' + '---|' * (len(phases) + 6)]
+    per_size = {t: [] for t in threads}   # (N, ns per particle-step) per thread count
     for dp in [float(s) for s in args.sizes.split(',')]:
         # the same window for every size: the first steps from rest take the
         # 1 ms step cap and harder PPEs, so a shorter window would not compare
@@ -67,9 +88,11 @@ def main():
             n = s['particles']['total']
             ps = s['steps'] * n
             cells = [f"{1e9 * s['phase_seconds'][p] / ps:.0f}" for p in phases]
+            per_size[t].append((n, s['ns_per_particle_step']))
             lines.append(f"| {dp * 1e3:.2f} | {n} | {t} | {s['steps']} | "
                          f"{s['ppe_iterations_per_step']:.1f} | " + ' | '.join(cells) +
                          f" | {s['ns_per_particle_step']:.0f} |")
+    lines += growth_table(per_size)
     lines += ['', '## The paper\'s coarsest dam break: 1 s of simulated time', '',
               f'Time step: the case\'s ({case_time_step()}), and the solver\'s defaults '
               '(Courant 0.2, droplets counted) for comparison.', '',
