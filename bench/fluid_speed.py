@@ -49,11 +49,9 @@ def growth_table(per_size):
            'N log N (whose cost per particle-step grows as log N):', '',
            '| from N | to N | threads | measured | N log N |', '|---|---|---|---|---|']
     for t, rows in per_size.items():
-        for (n1, c1), (n2, c2) in zip(rows, rows[1:]):
-            out.append(f'| {n1} | {n2} | {t} | {c2 / c1:.2f}x | '
-                       f'{math.log(n2) / math.log(n1):.2f}x |')
-        if len(rows) > 2:
-            (n1, c1), (n2, c2) = rows[0], rows[-1]
+        # each size to the next, then the smallest to the largest
+        pairs = list(zip(rows, rows[1:])) + ([(rows[0], rows[-1])] if len(rows) > 2 else [])
+        for (n1, c1), (n2, c2) in pairs:
             out.append(f'| {n1} | {n2} | {t} | {c2 / c1:.2f}x | '
                        f'{math.log(n2) / math.log(n1):.2f}x |')
     return out

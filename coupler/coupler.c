@@ -237,9 +237,10 @@ static enum mps_status open_endpoint(struct coupler *c, int k, struct mps_err *e
                            c->rundir, p->name, sizeof p->ipc_path - 1);
     /* copied, not printed: GCC 12 at -O0 cannot tell the two members apart
      * and warns of an overlap (-Wrestrict) */
-    _Static_assert(sizeof p->endpoint >= sizeof "ipc://" + sizeof p->ipc_path, "endpoint size");
-    memcpy(p->endpoint, "ipc://", 6);
-    memcpy(p->endpoint + 6, p->ipc_path, (size_t)len + 1);
+    static const char scheme[] = "ipc://";
+    _Static_assert(sizeof p->endpoint >= sizeof scheme + sizeof p->ipc_path, "endpoint size");
+    memcpy(p->endpoint, scheme, sizeof scheme - 1);
+    memcpy(p->endpoint + sizeof scheme - 1, p->ipc_path, (size_t)len + 1);
     return proto_link_open(c->zctx, PROTO_LINK_BIND, p->endpoint, &p->sock, err);
 }
 
