@@ -16,3 +16,12 @@ def write_keeping_notes(path, lines, marker):
     with open(path, 'w') as f:
         f.write('\n'.join(lines))
     return lines
+
+
+def host_line(summary):
+    """The machine and day of a bench, from a run's summary.json: speed
+    figures belong to a host (the same commit took 1.6x longer per fluid step
+    on one 2-core VM than on another)."""
+    import datetime
+    return (f"Host: {summary.get('host', 'not recorded')}; "
+            f"{datetime.date.today().isoformat()}.")

@@ -16,7 +16,7 @@ import argparse, os, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
-from bench_doc import write_keeping_notes  # noqa: E402
+from bench_doc import host_line, write_keeping_notes  # noqa: E402
 from dambreak_compare import run_dambreak  # noqa: E402
 
 
@@ -76,6 +76,7 @@ def main():
              ' | total ns/particle-step |',
              '|' + '---|' * (len(phases) + 6)]
     per_size = {t: [] for t in threads}   # (N, ns per particle-step) per thread count
+    host = ''
     for dp in [float(s) for s in args.sizes.split(',')]:
         # the same window for every size: the first steps from rest take the
         # 1 ms step cap and harder PPEs, so a shorter window would not compare
@@ -87,6 +88,9 @@ def main():
             ps = s['steps'] * n
             cells = [f"{1e9 * s['phase_seconds'][p] / ps:.0f}" for p in phases]
             per_size[t].append((n, s['ns_per_particle_step']))
+            if not host:   # the first run names the machine, under the title
+                host = host_line(s)
+                lines[3:3] = [host, '']
             lines.append(f"| {dp * 1e3:.2f} | {n} | {t} | {s['steps']} | "
                          f"{s['ppe_iterations_per_step']:.1f} | " + ' | '.join(cells) +
                          f" | {s['ns_per_particle_step']:.0f} |")

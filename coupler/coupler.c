@@ -23,6 +23,7 @@
 #include "mps_case.h"
 #include "mps_cli.h"
 #include "mps_h5.h"
+#include "mps_host.h"
 #include "mps_json.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
@@ -536,6 +537,9 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_str(&j, "program", "coupler");
     mps_json_str(&j, "version", MPS_VERSION);
     mps_json_str(&j, "git_rev", mps_git_rev);
+    char host[256];
+    mps_host_describe(host, sizeof host);
+    mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", c->cs ? mps_case_path(c->cs) : "");
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");

@@ -14,6 +14,7 @@
 #include "fluid_ppe.h"
 #include "mps_case.h"
 #include "mps_cli.h"
+#include "mps_host.h"
 #include "mps_json.h"
 #include "mps_omp.h"
 #include "mps_probes.h"
@@ -77,6 +78,9 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
     mps_json_str(&j, "solver", "fluid_solver");
     mps_json_str(&j, "version", MPS_VERSION);
     mps_json_str(&j, "git_rev", mps_git_rev);
+    char host[256];
+    mps_host_describe(host, sizeof host);
+    mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", r->cs ? mps_case_path(r->cs) : "");
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");

@@ -12,6 +12,7 @@
 #include "mps_case.h"
 #include "mps_cli.h"
 #include "mps_h5.h"
+#include "mps_host.h"
 #include "mps_json.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
@@ -71,6 +72,9 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
     mps_json_str(&j, "solver", "solid_solver");
     mps_json_str(&j, "version", MPS_VERSION);
     mps_json_str(&j, "git_rev", mps_git_rev);
+    char host[256];
+    mps_host_describe(host, sizeof host);
+    mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", mps_case_path(c));
     mps_json_int(&j, "particles", (long long)n);
     mps_json_int(&j, "steps", steps);

@@ -8,6 +8,9 @@ import csv, glob, json, os, signal, subprocess, sys, tempfile, time
 
 import h5py
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from host_expect import expected_host  # noqa: E402
+
 BIN = os.path.abspath(sys.argv[1])
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 SCENE = os.path.join(ROOT, 'tests', 'coupler', 'plate_in_water.yml')
@@ -87,6 +90,11 @@ def t_plate_force():
     check(s['status'] == 'ok', 'summary status ok')
     check(s['solvers']['solid']['exchanges'] == s['coupling_steps'], 'one solid exchange per fluid step')
     check(os.path.exists(os.path.join(out, 'scene.xmf')), 'scene.xmf written')
+    # timings are a property of the machine: each summary names it
+    fs = json.load(open(os.path.join(out, 'fluid_summary.json')))
+    for name, summary in (('coupler', s), ('fluid', fs)):
+        check(summary.get('host') == expected_host(),
+              f"{name} summary names the host: {summary.get('host')!r}")
 
 
 def t_moving_plate():

@@ -9,6 +9,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from host_expect import expected_host  # noqa: E402
+
 
 def main():
     out = sys.argv[1]
@@ -33,6 +36,8 @@ def main():
             fails.append(f"summary.json lacks {k}")
     if s.get("particles") != 115 or abs(s.get("time", 0) - 0.01) > 1e-15:
         fails.append(f"summary particles {s.get('particles')} time {s.get('time')}")
+    if s.get("host") != expected_host():
+        fails.append(f"summary host {s.get('host')!r}, expected {expected_host()!r}")
     phases = s.get("solid", {}).get("phase_seconds", {})
     if set(phases) != {"strain", "force", "update"}:
         fails.append(f"phase_seconds {phases}")
