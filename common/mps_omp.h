@@ -6,6 +6,18 @@
 
 #include <omp.h>
 
+/* Rows a thread takes at a time in the neighbour-sum loops whose rows differ
+ * in cost (schedule(dynamic, MPS_OMP_ROW_CHUNK)): long enough that each
+ * thread streams its rows' neighbour lists in order and the threads rarely
+ * meet on the shared counter, short enough to balance a few thousand rows.
+ * 256 against the 64 before (AMD EPYC VM, 2 threads, dam break, two or more
+ * runs each): 3.5 mm 581-592 against 602-608 ns per particle-step, 0.8 mm
+ * 938-949 against 985-1000; 512 and 1024 within the runs' spread of 256,
+ * 128 between; static (the rows' costs differ at walls and the surface)
+ * 670-673 at 3.5 mm. The same rows and sums either way: no loop under it
+ * reduces across rows, so the bits do not change. */
+#define MPS_OMP_ROW_CHUNK 256
+
 /* Binds each thread of the OpenMP pool to its own CPU (round robin over the
  * CPUs the process may use), unless OMP_PLACES or OMP_PROC_BIND is set (by
  * the user, or by the coupler, which places its solvers itself). Unbound,

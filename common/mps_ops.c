@@ -3,6 +3,7 @@
 #include <math.h>
 
 #include "mps_kernel.h"
+#include "mps_omp.h"
 #include "mps_simd.h"
 
 /* the AVX-512 operator paths are written for 2D */
@@ -17,7 +18,7 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -90,7 +91,7 @@ void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda
 #ifdef OPS_WIDE
     const int wide = mps_simd_wide();
 #endif
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         mps_nbr_prefetch_row(nl, i + MPS_NBR_PREFETCH_ROWS);
         if (!QUERY(in, i))
@@ -136,7 +137,7 @@ void mps_ops_laplacian(const struct mps_ops_in *in, double n0, double lambda, co
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re, coef = 2.0 * MPS_DIM / (lambda * n0);
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -221,7 +222,7 @@ void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, i
 {
     const struct mps_nbr_list *nl = in->nl;
     const double coef = MPS_DIM / n0;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -241,7 +242,7 @@ void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const do
 #if MPS_DIM == 2
     /* On a full lattice M = (1/n) sum e(x)e w = I/d, so det M = 1/d^2. */
     const double det_full = 1.0 / (MPS_DIM * MPS_DIM);
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
@@ -280,7 +281,7 @@ void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re, coef = MPS_DIM / n0;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;

@@ -8,6 +8,7 @@
 #include "fluid_ppe.h"
 #include "fluid_scene.h"
 #include "mps_kernel.h"
+#include "mps_omp.h"
 #include "mps_ops.h"
 
 static const char *const phase_names[PH_COUNT] = {
@@ -432,7 +433,7 @@ static void surface_scan(struct fluid *f)
 {
     const double re = f->prm.re_n * f->prm.dp, re2 = re * re;
     const double rs = f->prm.surface_scan * f->prm.dp, rs2 = rs * rs;
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < f->nfluid; i++) {
         if (!f->surface[i])
             continue;

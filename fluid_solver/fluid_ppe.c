@@ -5,6 +5,7 @@
 #include <stdlib.h>
 
 #include "mps_kernel.h"
+#include "mps_omp.h"
 #include "mps_simd.h"
 
 static int grow(void **p, size_t *cap, size_t need, size_t elem)
@@ -241,7 +242,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     int *rowptr = f->rowptr;
     rowptr[0] = 0;
     const int wide = mps_simd_wide();
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < n; i++)
         if (f->row[i] >= 0)
             rowptr[f->row[i] + 1] = row_weights(f, i, c, wide, &f->rhs[f->row[i]], &f->nwlap[i]) + 1;
@@ -256,7 +257,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     /* pass 2: values. Neighbour lists are sorted by particle index and rows
      * follow particle order, so columns come out sorted; the diagonal is
      * inserted in its place. */
-#pragma omp parallel for schedule(dynamic, 64)
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < n; i++) {
         int r = f->row[i];
         if (r < 0)
