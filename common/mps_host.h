@@ -1,6 +1,7 @@
 /* The machine a run ran on, for its summary: speed figures belong to a host
- * (the same commit took 1.6x longer per fluid step on one 2-core VM than on
- * another), so every summary.json names the CPU next to its timings. */
+ * (the same commit took 1.43x longer per fluid step at 6k particles on one
+ * 2-core VM than on another, and 11% less at 80k), so every summary.json
+ * names the CPU next to its timings. */
 #ifndef MPS_HOST_H
 #define MPS_HOST_H
 
