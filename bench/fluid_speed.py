@@ -90,7 +90,7 @@ def main():
             per_size[t].append((n, s['ns_per_particle_step']))
             if not host:   # the first run names the machine, under the title
                 host = host_line(s)
-                lines[3:3] = [host, '']
+                lines[4:4] = [host, '']   # after 'Reproduce: ...' and its blank line
             lines.append(f"| {dp * 1e3:.2f} | {n} | {t} | {s['steps']} | "
                          f"{s['ppe_iterations_per_step']:.1f} | " + ' | '.join(cells) +
                          f" | {s['ns_per_particle_step']:.0f} |")
