@@ -12,7 +12,7 @@ import argparse, os, sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'bench'))
-from bench_doc import write_keeping_notes  # noqa: E402
+from bench_doc import host_line, write_keeping_notes  # noqa: E402
 from dambreak_compare import compare, run_dambreak  # noqa: E402
 
 
@@ -51,6 +51,8 @@ def main():
             steps = (f'{s3["steps"]}' if ok3 else
                      f'{s3["steps"]}, stopped at t = {s3["simulated_time"]:.3f} s: '
                      f'{s3["message"]}')
+            if len(lines) == 6:   # the first row: name the machine under the title
+                lines[2:2] = [host_line(s3), '']
             lines.append(f'| {c:g} | {k} | {acc} | {steps} | {s3["wall_seconds"]:.1f} | '
                          f'{s3["ppe_iterations_per_step"]:.1f} | {s3["wall_guard_uses"]} |')
             print(lines[-1], flush=True)
