@@ -35,6 +35,7 @@ def main():
              '| Courant | droplets (k) | 4 mm front max / mean | 4 mm height max / mean | '
              '3 mm to 1 s: steps | wall s | PPE iters/step | guard uses |',
              '|---|---|---|---|---|---|---|---|']
+    named = False
     for c in (float(x) for x in a.courants.split(',')):
         for k in (0, 3):
             base = [f'fluid.courant={c}', f'fluid.droplet_neighbours={k}']
@@ -51,8 +52,9 @@ def main():
             steps = (f'{s3["steps"]}' if ok3 else
                      f'{s3["steps"]}, stopped at t = {s3["simulated_time"]:.3f} s: '
                      f'{s3["message"]}')
-            if len(lines) == 6:   # the first row: name the machine under the title
+            if not named:   # the first run names the machine, under the title
                 lines[2:2] = [host_line(s3), '']
+                named = True
             lines.append(f'| {c:g} | {k} | {acc} | {steps} | {s3["wall_seconds"]:.1f} | '
                          f'{s3["ppe_iterations_per_step"]:.1f} | {s3["wall_guard_uses"]} |')
             print(lines[-1], flush=True)
