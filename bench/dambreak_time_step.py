@@ -35,7 +35,6 @@ def main():
              '| Courant | droplets (k) | 4 mm front max / mean | 4 mm height max / mean | '
              '3 mm to 1 s: steps | wall s | PPE iters/step | guard uses |',
              '|---|---|---|---|---|---|---|---|']
-    named = False
     for c in (float(x) for x in a.courants.split(',')):
         for k in (0, 3):
             base = [f'fluid.courant={c}', f'fluid.droplet_neighbours={k}']
@@ -52,12 +51,10 @@ def main():
             steps = (f'{s3["steps"]}' if ok3 else
                      f'{s3["steps"]}, stopped at t = {s3["simulated_time"]:.3f} s: '
                      f'{s3["message"]}')
-            if not named:   # the first run names the machine, under the title
-                lines[2:2] = [host_line(s3), '']
-                named = True
             lines.append(f'| {c:g} | {k} | {acc} | {steps} | {s3["wall_seconds"]:.1f} | '
                          f'{s3["ppe_iterations_per_step"]:.1f} | {s3["wall_guard_uses"]} |')
             print(lines[-1], flush=True)
+    lines[2:2] = [host_line(s3), '']   # the machine, under the title
     lines.append('')
     # the hand-written reading (from "Command per row" on) is kept
     write_keeping_notes(a.out, lines, 'Command per row')

@@ -76,7 +76,6 @@ def main():
              ' | total ns/particle-step |',
              '|' + '---|' * (len(phases) + 6)]
     per_size = {t: [] for t in threads}   # (N, ns per particle-step) per thread count
-    host = ''
     for dp in [float(s) for s in args.sizes.split(',')]:
         # the same window for every size: the first steps from rest take the
         # 1 ms step cap and harder PPEs, so a shorter window would not compare
@@ -88,12 +87,10 @@ def main():
             ps = s['steps'] * n
             cells = [f"{1e9 * s['phase_seconds'][p] / ps:.0f}" for p in phases]
             per_size[t].append((n, s['ns_per_particle_step']))
-            if not host:   # the first run names the machine, under the title
-                host = host_line(s)
-                lines[4:4] = [host, '']   # after 'Reproduce: ...' and its blank line
             lines.append(f"| {dp * 1e3:.2f} | {n} | {t} | {s['steps']} | "
                          f"{s['ppe_iterations_per_step']:.1f} | " + ' | '.join(cells) +
                          f" | {s['ns_per_particle_step']:.0f} |")
+    lines[4:4] = [host_line(s), '']   # the machine, after 'Reproduce: ...'
     lines += growth_table(per_size)
     lines += ['', '## The paper\'s coarsest dam break: 1 s of simulated time', '',
               f'Time step: the case\'s ({case_time_step()}), and the solver\'s defaults '

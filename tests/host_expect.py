@@ -21,4 +21,3 @@ def expected_host():
     if 'cpu family' in info and 'model' in info:
         return f"{info['model name']} (family {info['cpu family']} model {info['model']}), {n} CPUs"
     return f"{info['model name']}, {n} CPUs"
-
