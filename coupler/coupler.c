@@ -382,8 +382,11 @@ static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
 }
 
 /* The next coupling step: the fluid's CFL step (or, for a solid alone, the
- * probe interval, over which the solid sub-cycles), shortened so output
- * times are hit exactly with no sliver left before them. */
+ * probe interval, over which the solid sub-cycles), shortened so t_next is
+ * hit exactly with no sliver left before it. With a fluid, t_next is the
+ * end of the run only: output and probe times are written at the end of the
+ * first step that reaches them, so they never change the solution
+ * (docs/pressure.md). */
 static double next_dt(const struct coupler *c, double t_next, double probe_interval)
 {
     double dt = c->p[FLUID].needed ? c->p[FLUID].dt : probe_interval;
@@ -410,9 +413,9 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
     while (c->time < end - eps) {
         double t_out = out_iv > 0.0 ? out_k * out_iv : INFINITY;
         double t_probe = probe_k * probe_iv;
-        double t_next = fmin(t_out, end);
-        if (!c->p[FLUID].needed)
-            t_next = fmin(t_next, t_probe); /* a lone solid reports at probe times */
+        double t_next = end;
+        if (!c->p[FLUID].needed) /* a lone solid steps from report to report */
+            t_next = fmin(fmin(t_out, end), t_probe);
         double dt = next_dt(c, t_next, probe_iv);
         uint32_t flags = 0;
         if (c->time + dt >= t_out - eps)
@@ -472,7 +475,8 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
                 probe_k++;
         }
         if (flags & PROTO_F_SNAPSHOT)
-            out_k++;
+            while (out_k * out_iv <= c->time + eps)
+                out_k++;
         mps_progress_update(&prog, c->time, c->step);
     }
     mps_progress_finish(&prog, c->time, c->step);

@@ -21,6 +21,11 @@ const struct mps_key_spec fluid_case_keys[] = {
      "smallest step the CFL condition may ask for before the run is declared diverged"},
     {"fluid.kappa", MPS_KEY_DOUBLE, "0.01", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "relaxation of the PPE source term (Eq. 23)"},
+    {"fluid.kappa_rate", MPS_KEY_ENUM, "fixed", 0, 0, 0, "fixed|per_step", "",
+     "how Eq. 23's kappa scales with the step: per_step is Eq. 23 as printed, a fraction kappa "
+     "of the density error corrected every step (its source and pressure scale as 1/dt^2 when "
+     "the step changes); fixed corrects kappa dt / dt_max per step, a fixed rate kappa / "
+     "fluid.dt_max (the two agree at dt = dt_max; docs/pressure.md)"},
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
@@ -74,6 +79,9 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.ppe_coarse_cell", MPS_KEY_DOUBLE, "4", 1, 100, 0, NULL, "dp",
      "pcg_defl: side of the square cells whose PPE rows form one aggregate of the coarse "
      "space (docs/ppe_solvers.md)"},
+    {"fluid.step_log", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
+     "write PREFIX_steps.csv: one row per step (dt, PPE iterations and rows, rows at P = 0, "
+     "collision pairs, neighbour-list builds), for diagnosing a run"},
     /* not REQUIRED in the schema: a solid-only case has no tank; the fluid
      * checks for it in fluid_params_read */
     {"fluid.tank.width", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "m",
@@ -127,6 +135,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->dt_max = mps_case_double(c, "fluid.dt_max");
     p->dt_min = mps_case_double(c, "fluid.dt_min");
     p->kappa = mps_case_double(c, "fluid.kappa");
+    p->kappa_fixed_rate = strcmp(mps_case_string(c, "fluid.kappa_rate"), "fixed") == 0;
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
     p->initial_hydrostatic =
@@ -152,6 +161,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->shift_coef = mps_case_double(c, "fluid.shifting");
     p->shift_max = mps_case_double(c, "fluid.shifting_max");
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");
+    p->step_log = mps_case_bool(c, "fluid.step_log");
     p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");
     p->ppe_max_iter = (int)mps_case_int(c, "fluid.ppe_max_iter");
     p->ppe_drop = mps_case_double(c, "fluid.ppe_drop");
