@@ -690,8 +690,10 @@ int main(int argc, char **argv)
     struct mps_err err = {0};
     struct mps_cli cli;
     struct mps_cli_extra extra[] = {
-        {"--solid", 1, "solid program command (overrides the case key solid_solver)", NULL},
-        {"--fluid", 1, "fluid program command (overrides the case key fluid_solver)", NULL},
+        {"--solid", 1, "solid program command (sets the case key solid_solver; refused "
+                       "for a case without a solid)", NULL},
+        {"--fluid", 1, "fluid program command (sets the case key fluid_solver; refused "
+                       "for a case without a fluid)", NULL},
         {"--external", 1, "fluid|solid: do not launch it; wait for it to connect", NULL},
     };
     const char *usage =

@@ -54,8 +54,9 @@ enum mps_status coupler_record_hello(struct coupler_record *r, struct mps_case *
                                      struct mps_err *err)
 {
     const char *role = peer == COUPLER_RECORD_SOLID ? "solid" : "fluid";
-    snprintf(r->hello[peer], sizeof r->hello[peer], "%s program: %s (HELLO model=%s)", role,
-             command, model);
+    /* our solid_solver without --model says "case": it runs solid.model */
+    snprintf(r->hello[peer], sizeof r->hello[peer], "%s program: %s (HELLO model=%s%s)", role,
+             command, model, strcmp(model, "case") == 0 ? ": the case's solid.model" : "");
     if (peer == COUPLER_RECORD_SOLID && strcmp(model, mps_case_string(*c, "solid.model")) != 0 &&
         (size_t)snprintf(r->model_set, sizeof r->model_set, "solid.model=%s", model) <
             sizeof r->model_set) {
