@@ -603,7 +603,8 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
     if (c->p[FLUID].bye) /* from the fluid's summary, as on the terminal */
-        mps_json_int(&j, "lost_particles", (long long)bye_number(&c->p[FLUID], "lost_particles", 0));
+        mps_json_int(&j, "lost_particles",
+                     (long long)bye_number(&c->p[FLUID], "lost_particles", 0.0));
     mps_json_str(&j, "cpu_placement", c->cpu_note);
     mps_json_object(&j, "solvers");
     for (int k = 0; k < NPEERS; k++) {
