@@ -1248,23 +1248,35 @@ char *mps_case_resolved_yaml(const struct mps_case *c)
 }
 
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
-                                        struct mps_err *err)
+                                        const char *comment, struct mps_err *err)
 {
     char *y = mps_case_resolved_yaml(c);
-    if (!y)
+    char *tmp = xprintf("%s.tmp", path);
+    if (!y || !tmp) {
+        free(y);
+        free(tmp);
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot build the resolved configuration",
                            path);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        free(y);
-        return mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", path,
-                           strerror(errno));
     }
-    int bad = fprintf(f, "# Resolved from %s (defaults filled in, --set applied)\n%s",
-                      c->path, y) < 0;
+    enum mps_status st = MPS_OK;
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        st = mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", tmp, strerror(errno));
+        goto done;
+    }
+    int bad = fprintf(f, "# Resolved from %s (defaults filled in, --set applied)\n%s%s", c->path,
+                      comment ? comment : "", y) < 0;
     bad |= fclose(f) != 0;
+    if (bad) {
+        st = mps_err_set(err, MPS_EIO, "%s: cannot write: %s", tmp, strerror(errno));
+        remove(tmp);
+    } else if (rename(tmp, path) != 0) {
+        st = mps_err_set(err, MPS_EIO, "cannot rename '%s' to '%s': %s", tmp, path,
+                         strerror(errno));
+        remove(tmp);
+    }
+done:
+    free(tmp);
     free(y);
-    if (bad)
-        return mps_err_set(err, MPS_EIO, "%s: cannot write: %s", path, strerror(errno));
-    return MPS_OK;
+    return st;
 }

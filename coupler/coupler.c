@@ -1,6 +1,9 @@
 /* coupler: the program users run, for every case.
  *   coupler CASE.yml --out DIR [--set key=value]... [--quiet]
  *           [--solid "COMMAND"] [--fluid "COMMAND"] [--external fluid|solid]
+ * --out is required; --solid, --fluid and --external are refused for a
+ * solver the case does not need. The run's record (coupler_record.h) goes
+ * into OUT/case_resolved.yml, which the solvers read.
  * It validates the whole case, launches the solvers the scene needs, talks to
  * them over ZeroMQ (proto/PROTOCOL.md) and owns simulation time: each step
  * the fluid advances with the solid's interface as its moving boundary, and
@@ -18,6 +21,7 @@
 #include <zmq.h>
 
 #include "coupler_keys.h"
+#include "coupler_record.h"
 #include "fluid_params.h"
 #include "launch.h"
 #include "mps_case.h"
@@ -27,6 +31,7 @@
 #include "mps_json.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
+#include "mps_prov.h"
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_link.h"
@@ -36,6 +41,9 @@
 #define SLICE_MS 200
 
 enum { FLUID = 0, SOLID = 1, NPEERS = 2 };
+_Static_assert((int)FLUID == (int)COUPLER_RECORD_FLUID &&
+                   (int)SOLID == (int)COUPLER_RECORD_SOLID &&
+                   (int)NPEERS == (int)COUPLER_RECORD_PEERS, "peer indices");
 
 struct peer {
     const char *name;
@@ -52,10 +60,13 @@ struct peer {
     double roundtrip_seconds;  /* ADVANCE sent -> RESULT received */
     long exchanges;
     char *bye;                 /* its summary JSON */
+    char model[64];            /* as its HELLO announced it */
 };
 
 struct coupler {
     struct mps_case *cs;
+    const struct mps_key_spec *const *tables; /* the case's key tables (4) */
+    struct coupler_record rec;
     const char *out;
     struct peer p[NPEERS];
     void *zctx;
@@ -270,7 +281,16 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
         return mps_err_set(err, MPS_EPROTO, "%s", reason);
     }
+    char model[64] = "";
+    proto_text_get(m.text, ' ', "model", model, sizeof model);
+    snprintf(p->model, sizeof p->model, "%s", model);
     proto_msg_clear(&m);
+    /* the file this solver is about to read records its own run */
+    enum mps_status rst = coupler_record_hello(
+        &c->rec, &c->cs, c->tables, 4, k,
+        p->external ? "(external: started by the user)" : p->child.command, p->model, err);
+    if (rst)
+        return rst;
     char cfg[8192];
     snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n", resolved_case,
              c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0));
@@ -378,7 +398,10 @@ static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
     }
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", c->out);
-    return mps_probes_open(&c->probes, path, names, n, err);
+    char *comment = mps_prov_comment(c->cs, "coupler");
+    enum mps_status st = mps_probes_open(&c->probes, path, comment, names, n, err);
+    free(comment);
+    return st;
 }
 
 /* The next coupling step: the fluid's CFL step (or, for a solid alone, the
@@ -526,6 +549,17 @@ static void abort_all(struct coupler *c, const char *reason)
         launch_reap(&c->p[k].child, 5.0);
 }
 
+/* The number after "key": in a solver's summary JSON (its BYE), or def. */
+static double bye_number(const struct peer *p, const char *key, double def)
+{
+    char quoted[96];
+    snprintf(quoted, sizeof quoted, "\"%s\"", key);
+    const char *s = p->bye ? strstr(p->bye, quoted) : NULL;
+    if (s && (s = strchr(s + strlen(quoted), ':')))
+        return strtod(s + 1, NULL);
+    return def;
+}
+
 static void write_summary(struct coupler *c, enum mps_status st, const struct mps_err *err)
 {
     char path[4200];
@@ -545,6 +579,10 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_host_describe(host, sizeof host);
     mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", c->cs ? mps_case_path(c->cs) : "");
+    if (c->cs) {
+        mps_prov_json(c->cs, &j);
+        mps_json_num(&j, "end_time", mps_case_double(c->cs, "end_time"));
+    }
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");
     mps_json_str(&j, "failed_solver", c->failed_peer);
@@ -559,10 +597,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
         struct peer *p = &c->p[k];
         if (!p->needed)
             continue;
-        double compute = 0.0;
-        const char *s = p->bye ? strstr(p->bye, "\"compute_seconds\"") : NULL;
-        if (s && (s = strchr(s, ':')))
-            compute = strtod(s + 1, NULL);
+        double compute = bye_number(p, "compute_seconds", 0.0);
         mps_json_num(&j, p->name, compute);
         solvers += compute;
         msg += p->roundtrip_seconds - compute;
@@ -571,6 +606,9 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_num(&j, "coupler_other", wall - solvers - msg);
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
+    if (c->p[FLUID].bye) /* from the fluid's summary, as on the terminal */
+        mps_json_int(&j, "lost_particles",
+                     (long long)bye_number(&c->p[FLUID], "lost_particles", 0.0));
     mps_json_str(&j, "cpu_placement", c->cpu_note);
     mps_json_object(&j, "solvers");
     for (int k = 0; k < NPEERS; k++) {
@@ -579,6 +617,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
             continue;
         mps_json_object(&j, p->name);
         mps_json_str(&j, "command", p->child.command);
+        mps_json_str(&j, "model", p->model); /* as its HELLO announced it */
         mps_json_str(&j, "endpoint", p->endpoint);
         mps_json_int(&j, "pid", (long long)p->child.pid);
         mps_json_int(&j, "exchanges", p->exchanges);
@@ -636,13 +675,30 @@ static void cleanup(struct coupler *c)
     mps_case_destroy(&c->cs);
 }
 
+/* Refuses an option that names a solver the case does not need: it would
+ * otherwise be ignored without a word (exit 2). */
+static int refuse_unneeded(const struct coupler *c, const char *option, const char *value,
+                           int peer, const char *case_path)
+{
+    if (!value || c->p[peer].needed)
+        return 0;
+    fprintf(stderr, "coupler: %s %s: %s has no %s (%s), so no %s program runs; drop the option "
+                    "or choose a case with a %s\n",
+            option, value, case_path, c->p[peer].name,
+            peer == FLUID ? "fluid.tank" : "solid.bodies", c->p[peer].name, c->p[peer].name);
+    return 1;
+}
+
 int main(int argc, char **argv)
 {
+    mps_prov_init(argc, argv);
     struct mps_err err = {0};
     struct mps_cli cli;
     struct mps_cli_extra extra[] = {
-        {"--solid", 1, "solid program command (overrides the case key solid_solver)", NULL},
-        {"--fluid", 1, "fluid program command (overrides the case key fluid_solver)", NULL},
+        {"--solid", 1, "solid program command (sets the case key solid_solver; refused "
+                       "for a case without a solid)", NULL},
+        {"--fluid", 1, "fluid program command (sets the case key fluid_solver; refused "
+                       "for a case without a fluid)", NULL},
         {"--external", 1, "fluid|solid: do not launch it; wait for it to connect", NULL},
     };
     const char *usage =
@@ -661,15 +717,22 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    if (!cli.out_dir) {
+        /* no silent ./out: a second run there would mix with the first */
+        fprintf(stderr, "coupler: missing --out DIR (see --help)\n");
+        return 2;
+    }
     struct coupler c = {0};
-    c.out = cli.out_dir ? cli.out_dir : "out";
+    c.out = cli.out_dir;
     c.quiet = cli.quiet;
     c.wall0 = mps_wall_seconds();
     c.p[FLUID].name = "fluid";
     c.p[SOLID].name = "solid";
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
                                                  solid_case_keys, coupler_case_keys};
-    st = mps_case_load(&c.cs, cli.case_path, cli.sets, cli.nsets, tables, 4, NULL, &err);
+    c.tables = tables;
+    coupler_record_init(&c.rec, &cli, extra[0].value, extra[1].value);
+    st = mps_case_load(&c.cs, cli.case_path, c.rec.sets, c.rec.nsets, tables, 4, NULL, &err);
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
         return mps_status_exit_code(st);
@@ -690,6 +753,13 @@ int main(int argc, char **argv)
     if (!c.p[FLUID].needed && !c.p[SOLID].needed) {
         fprintf(stderr, "coupler: %s: the case has neither a fluid (fluid.tank) nor a solid "
                         "(solid.bodies)\n", cli.case_path);
+        mps_case_destroy(&c.cs);
+        return 2;
+    }
+    if (refuse_unneeded(&c, "--solid", extra[0].value, SOLID, cli.case_path) ||
+        refuse_unneeded(&c, "--fluid", extra[1].value, FLUID, cli.case_path) ||
+        refuse_unneeded(&c, "--external", ext, ext && !strcmp(ext, "solid") ? SOLID : FLUID,
+                        cli.case_path)) {
         mps_case_destroy(&c.cs);
         return 2;
     }
@@ -714,7 +784,7 @@ int main(int argc, char **argv)
         }
     }
 
-    char resolved[4200];
+    const char *resolved = c.rec.path;
     if ((st = mps_mkdir_p(c.out, &err)))
         goto end;
     {
@@ -723,9 +793,11 @@ int main(int argc, char **argv)
             st = mps_err_set(&err, MPS_EIO, "%s: %s", c.out, strerror(errno));
             goto end;
         }
-        snprintf(resolved, sizeof resolved, "%s/case_resolved.yml", abs_out);
+        snprintf(c.rec.path, sizeof c.rec.path, "%s/case_resolved.yml", abs_out);
     }
-    if ((st = mps_case_write_resolved(c.cs, resolved, &err)))
+    /* written now, so a run that fails to start leaves it too; rewritten as
+     * each solver says hello (coupler_record_hello) */
+    if ((st = coupler_record_write(&c.rec, c.cs, &err)))
         goto end;
     snprintf(c.rundir, sizeof c.rundir, "/tmp/mpsfsi-XXXXXX");
     if (!mkdtemp(c.rundir)) {
@@ -750,19 +822,19 @@ int main(int argc, char **argv)
         if ((st = open_endpoint(&c, k, &err)))
             goto end;
         p->active = 1; /* listened to from now on */
-        const char *cmd = extra[k == FLUID ? 1 : 0].value;
-        if (!cmd)
-            cmd = mps_case_string(c.cs, k == FLUID ? "fluid_solver" : "solid_solver");
+        /* --solid/--fluid are already in the case (coupler_record_init) */
+        const char *cmd = mps_case_string(c.cs, k == FLUID ? "fluid_solver" : "solid_solver");
         snprintf(p->child.command, sizeof p->child.command, "%s", cmd);
         if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint, &err)))
             goto end;
         p->child.name = p->name;
     }
     /* one solver at a time, so the only message that can come unasked is an
-     * ERROR */
-    for (int k = 0; k < NPEERS; k++)
-        if (c.p[k].needed &&
-            ((st = handshake(&c, k, resolved, &err)) || (st = await_ready(&c, k, &err))))
+     * ERROR; the solid first, so the model its HELLO names is in the case
+     * file before the fluid reads it (coupler_record_hello) */
+    for (int q = NPEERS - 1; q >= 0; q--)
+        if (c.p[q].needed &&
+            ((st = handshake(&c, q, resolved, &err)) || (st = await_ready(&c, q, &err))))
             goto end;
     if ((st = open_probes(&c, &err)))
         goto end;
@@ -784,6 +856,11 @@ end:
     if (c.cs && c.out) {
         write_summary(&c, st, &err);
         write_scene(&c);
+        long lost = (long)bye_number(&c.p[FLUID], "lost_particles", 0);
+        if (lost > 0) /* a result, not progress: --quiet keeps it */
+            fprintf(stderr, "coupler: %ld fluid particle%s left over the open tank walls "
+                            "(removed; lost_particles in summary.json)\n",
+                    lost, lost == 1 ? "" : "s");
     }
     cleanup(&c);
     return mps_status_exit_code(st);

@@ -28,6 +28,10 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "velocity", MPS_DIM, MPS_F64, (void **)&f->v, "m/s", 1);
     mps_particles_add_field(ps, "pressure", 1, MPS_F64, (void **)&f->p, "Pa", 1);
     mps_particles_add_field(ps, "type", 1, MPS_I32, (void **)&f->type, "", 1);
+    /* the codes of enum fluid_ptype that snapshots hold: a coupled solid's
+     * particles (3, 4) are written by the solid (fluid_solver/main.c) */
+    mps_particles_set_legend(ps, "type", "0 fluid, 1 wall (first layer), 2 dummy (outer wall "
+                                         "layers)");
     mps_particles_add_field(ps, "id", 1, MPS_I32, (void **)&f->id, "", 1);
     mps_particles_add_field(ps, "number_density", 1, MPS_F64, (void **)&f->nd, "", 1);
     mps_particles_add_field(ps, "free_surface", 1, MPS_U8, (void **)&f->surface, "", 1);

@@ -36,7 +36,8 @@ Exit status 0 only if every check passes. On failure one line goes to stderr
 usage: conformance.py --solid "COMMAND [ARG]..." [--case CASE.yml]
                       [--set key=value]... [--build DIR] [--xfail CHECK]...
 --build DIR: a bare program name (no '/') is looked up in DIR/bin first, as the
-coupler looks beside itself. --xfail CHECK (fnmatch pattern): a known failure,
+coupler looks beside itself (default: build/ of this repository, where
+./setup.sh builds), then on PATH. --xfail CHECK (fnmatch pattern): a known failure,
 printed XFAIL; if it passes it is reported XPASS and counts as a failure, so
 the mark is removed once the solver is fixed.
 """
@@ -203,7 +204,10 @@ class Session:
                                          stderr=subprocess.STDOUT, start_new_session=True,
                                          preexec_fn=_die_with_parent)
         except OSError as e:
-            self.suite.check(f'{self.name}.launch', False, f'cannot start {self.suite.command[0]}: {e}')
+            where = '' if '/' in self.suite.command[0] else \
+                f' (not in {os.path.join(self.suite.args.build, "bin")} nor on PATH; see --build)'
+            self.suite.check(f'{self.name}.launch', False,
+                             f'cannot start {self.suite.command[0]}: {e}{where}')
             raise Stop from e
         self.suite.current = self
         self.t0 = time.monotonic()
@@ -771,7 +775,9 @@ def main():
     ap.add_argument('--solid', required=True, help='solid solver command (quoted)')
     ap.add_argument('--case', default=os.path.join(HERE, 'conformance_case.yml'))
     ap.add_argument('--set', action='append', default=[], metavar='KEY=VALUE')
-    ap.add_argument('--build', help='build directory: bare program names are looked up in BUILD/bin')
+    ap.add_argument('--build', default=os.path.join(HERE, '..', '..', 'build'),
+                    help='build directory: bare program names are looked up in BUILD/bin '
+                         '(default: build/ of this repository)')
     ap.add_argument('--xfail', action='append', default=[], metavar='CHECK',
                     help='a check known to fail (fnmatch pattern)')
     ap.add_argument('--dt', type=float, default=1e-3, help='coupling step, s (default 1e-3)')

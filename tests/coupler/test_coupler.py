@@ -31,7 +31,7 @@ def run(args, timeout=120, **kw):
 
 def probes(out):
     with open(os.path.join(out, 'probes.csv')) as f:
-        return list(csv.DictReader(f))
+        return list(csv.DictReader(l for l in f if not l.startswith('#')))  # '#': provenance
 
 
 def solver_pids(out):
