@@ -268,6 +268,140 @@ def t_cpu_placement():
     check(note.startswith('off'), f'summary says off: {note!r}')
 
 
+def free_port_pair():
+    """A base port p with p and p + 1 free on the loopback (the coupler binds
+    fluid on p, solid on p + 1)."""
+    import random
+    import socket
+    for _ in range(200):
+        p = random.randint(20000, 60000)
+        try:
+            with socket.socket() as a, socket.socket() as b:
+                a.bind(('127.0.0.1', p))
+                b.bind(('127.0.0.1', p + 1))
+            return p
+        except OSError:
+            continue
+    raise RuntimeError('no free port pair')
+
+
+def child_info(coupler_pid, want=b'_solver', tries=300):
+    """{name: (pid, cmdline words, environ dict)} of the coupler's solver
+    children once both run."""
+    found = {}
+    for _ in range(tries):
+        kids = subprocess.run(['pgrep', '-P', str(coupler_pid)], capture_output=True,
+                              text=True).stdout.split()
+        for k in kids:
+            try:
+                cmd = open(f'/proc/{k}/cmdline', 'rb').read().split(b'\0')
+                env = dict(e.split(b'=', 1) for e in open(f'/proc/{k}/environ', 'rb').read().split(b'\0') if b'=' in e)
+            except OSError:
+                continue
+            name = 'fluid' if b'fluid_solver' in cmd[0] else 'solid'
+            found[name] = (int(k), cmd, env)
+        if len(found) == 2:
+            break
+        time.sleep(0.05)
+    return found
+
+
+PLATE = ['cases/dambreak_elastic_plate/case.yml', '--quiet', '--set', 'dp=0.006',
+         '--set', 'end_time=0.3']
+
+
+def t_stranger():
+    """Issue 20's proof. A tcp run of the coupled 6 mm plate to 0.3 s while
+    a stranger connects to both endpoints again and again, sending garbage,
+    the 80-byte RESULT forgery and a well-formed forged RESULT, as a raw TCP
+    client, as a ZeroMQ peer without security and as a CURVE peer that knows
+    the coupler's public key but holds a key of its own. The run must end ok
+    with probes.csv byte for byte that of the same run without the stranger
+    (runs are deterministic for a given build, thread count and input), and
+    the coupler must have counted and named the refusals."""
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from stranger import Stranger
+    env = dict(os.environ, OMP_NUM_THREADS='2')
+    port = free_port_pair()
+    tcp = ['--set', 'coupling.transport=tcp', '--set', f'coupling.tcp_port={port}']
+    quiet_out = tempfile.mkdtemp(prefix='cpl_alone_')
+    rc, err = run(PLATE + ['--out', quiet_out] + tcp, env=env, cwd=ROOT)
+    check(rc == 0, f'tcp run without a stranger exits 0 ({err.strip()[-200:]})')
+    out = tempfile.mkdtemp(prefix='cpl_stranger_')
+    p = subprocess.Popen([COUPLER] + PLATE + ['--out', out] + tcp, stderr=subprocess.PIPE,
+                         text=True, env=env, cwd=ROOT)
+    kids = child_info(p.pid)
+    key_file = kids.get('solid', (0, [], {}))[2].get(b'MPS_COUPLING_KEY', b'').decode()
+    server_public = None
+    if key_file:
+        for line in open(key_file):
+            if line.startswith('server_public='):
+                server_public = line.strip().split('=', 1)[1].encode()
+    check(server_public is not None, f'the stranger learnt the server public key ({key_file})')
+    s = Stranger('127.0.0.1', [port, port + 1], server_public).start()
+    err = p.communicate(timeout=170)[1]
+    s.finish()
+    print(f'stranger attempts: {s.attempts}')
+    check(p.returncode == 0, f'run with the stranger exits 0 ({err.strip()[-300:]})')
+    summ = json.load(open(os.path.join(out, 'summary.json')))
+    check(summ['status'] == 'ok', f"summary status {summ['status']!r}")
+    same = open(os.path.join(out, 'probes.csv'), 'rb').read() == \
+        open(os.path.join(quiet_out, 'probes.csv'), 'rb').read()
+    check(same, 'probes.csv identical to the run without the stranger')
+    ref = summ.get('refused_connections', {})
+    print(f'refused: {ref}')
+    check(all(s.attempts[k] > 0 for k in s.attempts), 'the stranger tried every kind of attack')
+    check(ref.get('count', 0) >= s.attempts['raw'],
+          f"refusals counted ({ref.get('count')}) >= raw connections made ({s.attempts['raw']})")
+    check(all(ref.get('by_endpoint', {}).get(e, 0) > 0 for e in ('fluid', 'solid')),
+          'refusals on both endpoints')
+    check(ref.get('by_address', {}).get('127.0.0.1', 0) > 0, 'the stranger is named by address')
+    check('refused a connection to the' in err and 'from 127.0.0.1' in err,
+          'the log names the stranger')
+    check(summ.get('transport') == 'tcp+curve', f"transport {summ.get('transport')!r}")
+
+
+def t_run_dir_private():
+    """ipc: the run directory holding the sockets is 0700 (that is the whole
+    protection on ipc); tcp: the solver's key file there is 0600, reaches the
+    solver through its environment, and is on no command line."""
+    import stat
+    for transport in ('ipc', 'tcp'):
+        out = tempfile.mkdtemp(prefix=f'cpl_priv_{transport}_')
+        extra = ['--set', f'coupling.transport={transport}']
+        if transport == 'tcp':
+            extra += ['--set', f'coupling.tcp_port={free_port_pair()}']
+        p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                              '--set', 'end_time=2'] + extra, stderr=subprocess.PIPE, text=True)
+        kids = child_info(p.pid)
+        fluid = kids.get('fluid')
+        check(fluid is not None, f'{transport}: found the fluid solver')
+        if fluid:
+            ep = fluid[1][fluid[1].index(b'--connect') + 1].decode()
+            if transport == 'ipc':
+                rundir = os.path.dirname(ep[len('ipc://'):])
+                mode = stat.S_IMODE(os.stat(rundir).st_mode)
+                check(mode == 0o700, f'ipc: run directory {rundir} has mode {mode:o} (0700)')
+                check(os.stat(rundir).st_uid == os.getuid(), 'ipc: run directory is ours')
+            else:
+                kf = fluid[2].get(b'MPS_COUPLING_KEY', b'').decode()
+                check(kf != '', f'tcp: key file in the solver environment ({kf})')
+                if kf:
+                    mode = stat.S_IMODE(os.stat(kf).st_mode)
+                    check(mode == 0o600, f'tcp: key file mode {mode:o} (0600)')
+                    dmode = stat.S_IMODE(os.stat(os.path.dirname(kf)).st_mode)
+                    check(dmode == 0o700, f'tcp: its directory has mode {dmode:o} (0700)')
+                    secret = [l.split('=', 1)[1].strip() for l in open(kf)
+                              if l.startswith('client_secret=')][0].encode()
+                    for name, (pid, cmd, env) in kids.items():
+                        check(secret not in b' '.join(cmd) and kf.encode() not in b' '.join(cmd),
+                              f'tcp: neither the key nor its file on the {name} command line')
+        p.send_signal(signal.SIGTERM)
+        p.communicate(timeout=60)
+        if transport == 'tcp' and fluid and kf:
+            check(not os.path.exists(kf), 'tcp: the key file is removed at the end')
+
+
 TESTS = {k[2:]: v for k, v in globals().items() if k.startswith('t_')}
 
 if __name__ == '__main__':
