@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "mps_budget.h"
+
 #define NOHI (MPS_KEY_NO_HI)
 #define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
 
@@ -209,6 +211,17 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
         if (p->block[b][3] > top)
             top = p->block[b][3];
     }
+
+    /* Before anything is allocated: water blocks and wall layers round the
+     * tank (an upper bound: blocks may overlap). */
+    double water = 0.0;
+    for (int b = 0; b < p->nblocks; b++)
+        water += (p->block[b][2] - p->block[b][0]) * (p->block[b][3] - p->block[b][1]);
+    double nparticles = water / (p->dp * p->dp) +
+                        (p->wall_layers + 1.0) * 2.0 * (p->tank_w + p->tank_h) / p->dp;
+    enum mps_status st = mps_budget_check(c, "dp", "fluid", nparticles, MPS_BUDGET_FLUID_BYTES, err);
+    if (st)
+        return st;
 
     /* The CFL cap must be satisfiable: a column of height H reaches about
      * sqrt(2 g H) on collapse, so the CFL step is C dp / sqrt(2 g H). */

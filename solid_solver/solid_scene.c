@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mps_budget.h"
+
 #define ANY (MPS_KEY_NO_LO | MPS_KEY_NO_HI)
 #define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
 
@@ -81,7 +83,9 @@ const struct mps_key_spec solid_case_keys[] = {
 static long lattice_count(double lo, double hi, double dp)
 {
     double n = floor((hi - lo) / dp + 1e-6);
-    return n > 0 ? (long)n : 0;
+    /* capped so the conversion stays defined; the memory check refuses
+     * such a body anyway */
+    return n > 0 ? (long)fmin(n, 1e15) : 0;
 }
 
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
@@ -190,6 +194,17 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
                                  wide ? "y0" : "x0");
         }
     }
+
+    double nparticles = 0.0;
+    for (int b = 0; b < s->nbodies; b++) {
+        long nx, ny;
+        solid_scene_lattice(s, b, &nx, &ny);
+        nparticles += (double)nx * (double)ny;
+    }
+    enum mps_status st = mps_budget_check(c, "dp", "solid", nparticles, MPS_BUDGET_SOLID_BYTES,
+                                          err);
+    if (st)
+        return st;
 
     s->nclamps = mps_case_count(c, "solid.clamps");
     if (s->nclamps > SOLID_MAX_CLAMPS)
