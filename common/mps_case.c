@@ -553,8 +553,17 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
             if (p->context)
                 snprintf(ctx, sizeof ctx, " (%s at line %lu)", p->context,
                          (unsigned long)p->context_mark.line + 1);
-            return mps_err_set(err, MPS_EINPUT, "%s:%lu: YAML syntax error: %s%s", file,
-                               (unsigned long)p->problem_mark.line + 1,
+            unsigned long at = (unsigned long)p->problem_mark.line + 1;
+            if (p->error == YAML_READER_ERROR) {
+                /* the reader (bad UTF-8, a control byte) gives a byte offset,
+                 * not a line: count the lines up to it */
+                const unsigned char *in = p->input.string.start;
+                size_t off = p->problem_offset, n = (size_t)(p->input.string.end - in);
+                at = 1;
+                for (size_t k = 0; in && k < off && k < n; k++)
+                    at += in[k] == '\n';
+            }
+            return mps_err_set(err, MPS_EINPUT, "%s:%lu: YAML syntax error: %s%s", file, at,
                                p->problem ? p->problem : "unknown", ctx);
         }
         int line = (int)ev.start_mark.line + 1;

@@ -31,6 +31,7 @@
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_link.h"
+#include "scene_check.h"
 #include "solid_scene.h"
 
 #define MAX_PROBES 64
@@ -748,6 +749,8 @@ int main(int argc, char **argv)
             st = fluid_params_read(&fp, c.cs, &err);
         if (!st && sc)
             st = solid_scene_read(sc, c.cs, &err);
+        if (!st && sc && c.p[FLUID].needed)
+            st = scene_check_fsi(&fp, sc, c.cs, &err);
         free(sc);
         if (st) {
             fprintf(stderr, "coupler: %s\n", err.msg);

@@ -184,6 +184,17 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             if (strcmp(s->bodies[a].name, d->name) == 0)
                 return mps_case_fail(c, err, key, "body name already used by "
                                      "solid.bodies.%d", a);
+        /* two bodies in one place would put particles on top of each other */
+        for (int a = 0; a < b; a++) {
+            const struct solid_body_def *o = &s->bodies[a];
+            double tol = 1e-3 * s->dp;
+            if (fmin(d->x1, o->x1) - fmax(d->x0, o->x0) > tol &&
+                fmin(d->y1, o->y1) - fmax(d->y0, o->y0) > tol) {
+                snprintf(key, sizeof key, "solid.bodies.%d.x0", b);
+                return mps_case_fail(c, err, key, "body '%s' overlaps body '%s' ([%g, %g] x "
+                                     "[%g, %g])", d->name, o->name, o->x0, o->x1, o->y0, o->y1);
+            }
+        }
         long nx, ny;
         solid_scene_lattice(s, b, &nx, &ny);
         if (nx == 0) {
