@@ -402,6 +402,55 @@ def t_run_dir_private():
             check(not os.path.exists(kf), 'tcp: the key file is removed at the end')
 
 
+def t_external_key():
+    """A solver started by hand (--external solid) over tcp: the coupler says
+    where the key file is; a solid with a key of its own is refused (counted,
+    the run waits on), the one started with --key FILE joins and the run
+    ends ok."""
+    import select
+    port = free_port_pair()
+    out = tempfile.mkdtemp(prefix='cpl_ext_')
+    p = subprocess.Popen([COUPLER, SCENE, '--out', out, '--external', 'solid', '--set',
+                          'end_time=0.05', '--set', 'coupling.transport=tcp', '--set',
+                          f'coupling.tcp_port={port}'], stderr=subprocess.PIPE, text=True)
+    key, seen = None, ''
+    t0 = time.time()
+    while key is None and time.time() - t0 < 30:
+        if select.select([p.stderr], [], [], 1.0)[0]:
+            line = p.stderr.readline()
+            seen += line
+            if 'copy ' in line and ' to its host' in line:
+                key = line.split('copy ', 1)[1].split(' to its host')[0]
+    check(key is not None and os.path.exists(key), f'the coupler names the key file ({key})')
+    if key is None:
+        p.kill()
+        return
+    solid = os.path.join(BIN, 'solid_solver')
+    # a key file of the right form but of another run: its handshake fails
+    fake = os.path.join(out, 'other.key')
+    import zmq
+    spub, _ = zmq.curve_keypair()
+    cpub, csec = zmq.curve_keypair()
+    fd = os.open(fake, os.O_WRONLY | os.O_CREAT, 0o600)
+    os.write(fd, f'server_public={spub.decode()}\nclient_public={cpub.decode()}\n'
+                 f'client_secret={csec.decode()}\n'.encode())
+    os.close(fd)
+    wrong = subprocess.Popen([solid, '--connect', f'tcp://127.0.0.1:{port + 1}', '--key', fake,
+                              '--timeout', '2'], stderr=subprocess.PIPE, text=True)
+    wrong_err = wrong.communicate(timeout=30)[1]
+    check(wrong.returncode != 0, f'a solid with another key gets nowhere (exit {wrong.returncode})')
+    good = subprocess.Popen([solid, '--connect', f'tcp://127.0.0.1:{port + 1}', '--key', key,
+                             '--quiet'], stderr=subprocess.PIPE, text=True)
+    err = p.communicate(timeout=120)[1]
+    good.communicate(timeout=30)
+    check(p.returncode == 0 and good.returncode == 0,
+          f'with the key it joins and the run ends ok (coupler {p.returncode}, solid '
+          f'{good.returncode}; {err.strip()[-200:]})')
+    s = json.load(open(os.path.join(out, 'summary.json')))
+    check(s['refused_connections']['by_endpoint'].get('solid', 0) >= 1,
+          f"the wrong key was counted ({s['refused_connections']})")
+
+
 TESTS = {k[2:]: v for k, v in globals().items() if k.startswith('t_')}
 
 if __name__ == '__main__':
