@@ -6,9 +6,9 @@
  * waits for the coupler's loop.
  *
  * Use: guard_create() before any CURVE socket is bound; guard_allow() and
- * guard_watch() per endpoint (watch before bind); guard_start(); at the end
- * guard_stop() (before the watched sockets close), then read the counts and
- * guard_destroy(). */
+ * guard_watch() per endpoint (watch right after the bind, before any solver
+ * is launched); guard_start(); at the end guard_stop() (before the watched
+ * sockets close), then read the counts and guard_destroy(). */
 #ifndef GUARD_H
 #define GUARD_H
 
@@ -28,7 +28,8 @@ enum mps_status guard_allow(struct guard *g, const char *domain, const char *cli
                             struct mps_err *err);
 
 /* Watches sock (a bound CURVE server with ZAP domain `domain`) for refused
- * handshakes. Call before zmq_bind so no connection is missed. */
+ * connections. Events before this call are not seen (they are still refused,
+ * only not counted), so call it right after the bind. */
 enum mps_status guard_watch(struct guard *g, void *sock, const char *domain,
                             struct mps_err *err);
 
