@@ -258,7 +258,8 @@ static enum mps_status open_tcp_endpoint(struct coupler *c, int k, struct mps_er
         return st;
     if ((st = proto_link_open_secure(c->zctx, PROTO_LINK_BIND, bind, &c->curve, p->name,
                                      &p->sock, err)))
-        return st;
+        return mps_err_prefix(err, "coupling.tcp_bind = %s, coupling.tcp_port = %ld: ",
+                              bind_host, port - k);
     /* from here every connection refused on this socket is counted */
     return guard_watch(c->guard, p->sock, p->name, err);
 }
@@ -796,6 +797,8 @@ int main(int argc, char **argv)
             goto end;
         p->active = 1; /* listened to from now on */
     }
+    /* every socket holds its copy of the server's secret key now */
+    memset(c.curve.server_secret, 0, sizeof c.curve.server_secret);
     /* the ZAP handler answers before any solver is launched */
     if (c.guard && (st = guard_start(c.guard, stderr, &err)))
         goto end;
