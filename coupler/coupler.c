@@ -23,6 +23,7 @@
 #include "coupler_keys.h"
 #include "coupler_record.h"
 #include "fluid_params.h"
+#include "guard.h"
 #include "launch.h"
 #include "mps_case.h"
 #include "mps_cli.h"
@@ -35,6 +36,7 @@
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_link.h"
+#include "scene_check.h"
 #include "solid_scene.h"
 
 #define MAX_PROBES 64
@@ -51,6 +53,7 @@ struct peer {
     int engaged;               /* handshake started: its socket is listened to */
     char endpoint[512];
     char ipc_path[108];        /* a Unix socket path's limit (sun_path) */
+    char key_path[300];        /* tcp: its CURVE key file in the run directory */
     void *sock;
     struct child child;
     double dt;                 /* latest stable step it reported */
@@ -70,6 +73,8 @@ struct coupler {
     const char *out;
     struct peer p[NPEERS];
     void *zctx;
+    struct guard *guard;       /* tcp: ZAP handler, refused connections */
+    struct proto_curve curve;  /* tcp: this run's server key pair */
     char rundir[256];
     char cpu_note[160];    /* what coupling.pin_cpus did, for the summary */
     int quiet;
@@ -232,17 +237,49 @@ static enum mps_status expect(struct coupler *c, int k, struct proto_msg *m, enu
 
 /* ---- startup ---- */
 
+/* tcp: CURVE with keys made for this run (PROTOCOL.md section 10). The
+ * solver's key file goes into the private run directory; the ZAP handler
+ * accepts that solver's public key on its endpoint and nothing else. */
+static enum mps_status open_tcp_endpoint(struct coupler *c, int k, struct mps_err *err)
+{
+    struct peer *p = &c->p[k];
+    long port = mps_case_int(c->cs, "coupling.tcp_port") + k;
+    const char *bind_host = mps_case_string(c->cs, "coupling.tcp_bind");
+    char bind[320];
+    snprintf(bind, sizeof bind, "tcp://%s:%ld", bind_host, port);
+    snprintf(p->endpoint, sizeof p->endpoint, "tcp://%s:%ld",
+             mps_case_string(c->cs, "coupling.tcp_host"), port);
+    enum mps_status st;
+    if (!c->guard) {
+        if ((st = proto_key_pair(c->curve.server_public, c->curve.server_secret, err)) ||
+            (st = guard_create(&c->guard, c->zctx, err)))
+            return st;
+    }
+    struct proto_curve ck = c->curve;
+    if ((st = proto_key_pair(ck.client_public, ck.client_secret, err)))
+        return st;
+    snprintf(p->key_path, sizeof p->key_path, "%s/%s.key", c->rundir, p->name);
+    st = proto_key_write(p->key_path, &ck, err);
+    if (st)
+        p->key_path[0] = '\0';
+    else
+        st = guard_allow(c->guard, p->name, ck.client_public, err);
+    memset(&ck, 0, sizeof ck); /* the coupler keeps only the public half */
+    if (st)
+        return st;
+    if ((st = proto_link_open_secure(c->zctx, PROTO_LINK_BIND, bind, &c->curve, p->name,
+                                     &p->sock, err)))
+        return mps_err_prefix(err, "coupling.tcp_bind = %s, coupling.tcp_port = %ld: ",
+                              bind_host, port - k);
+    /* from here every connection refused on this socket is counted */
+    return guard_watch(c->guard, p->sock, p->name, err);
+}
+
 static enum mps_status open_endpoint(struct coupler *c, int k, struct mps_err *err)
 {
     struct peer *p = &c->p[k];
-    if (strcmp(mps_case_string(c->cs, "coupling.transport"), "tcp") == 0) {
-        long port = mps_case_int(c->cs, "coupling.tcp_port") + k;
-        char bind[64];
-        snprintf(bind, sizeof bind, "tcp://*:%ld", port);
-        snprintf(p->endpoint, sizeof p->endpoint, "tcp://%s:%ld",
-                 mps_case_string(c->cs, "coupling.tcp_host"), port);
-        return proto_link_open(c->zctx, PROTO_LINK_BIND, bind, &p->sock, err);
-    }
+    if (strcmp(mps_case_string(c->cs, "coupling.transport"), "tcp") == 0)
+        return open_tcp_endpoint(c, k, err);
     int len = snprintf(p->ipc_path, sizeof p->ipc_path, "%s/%s.sock", c->rundir, p->name);
     if (len < 0 || (size_t)len >= sizeof p->ipc_path)
         return mps_err_set(err, MPS_EIO, "coupler: socket path %s/%s.sock is longer than %zu bytes",
@@ -262,7 +299,12 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     struct peer *p = &c->p[k];
     struct proto_msg m = {0};
     p->engaged = 1;
-    if (p->external && !c->quiet)
+    if (p->external && !c->quiet && p->key_path[0])
+        fprintf(stderr,
+                "coupler: waiting for the %s solver: copy %s to its host (keep it private: "
+                "mode 600) and run it with --connect %s --key FILE\n",
+                p->name, p->key_path, p->endpoint);
+    else if (p->external && !c->quiet)
         fprintf(stderr, "coupler: waiting for the %s solver: run it with --connect %s\n", p->name,
                 p->endpoint);
     enum mps_status st = expect(c, k, &m, PROTO_HELLO,
@@ -610,6 +652,8 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
         mps_json_int(&j, "lost_particles",
                      (long long)bye_number(&c->p[FLUID], "lost_particles", 0.0));
     mps_json_str(&j, "cpu_placement", c->cpu_note);
+    mps_json_str(&j, "transport", c->guard ? "tcp+curve" : "ipc");
+    guard_json(c->guard, &j); /* strangers turned away below the protocol */
     mps_json_object(&j, "solvers");
     for (int k = 0; k < NPEERS; k++) {
         struct peer *p = &c->p[k];
@@ -659,10 +703,14 @@ static void write_scene(struct coupler *c)
 
 static void cleanup(struct coupler *c)
 {
+    guard_destroy(&c->guard);
+    memset(&c->curve, 0, sizeof c->curve);
     for (int k = 0; k < NPEERS; k++) {
         proto_link_close(&c->p[k].sock);
         if (c->p[k].ipc_path[0])
             unlink(c->p[k].ipc_path);
+        if (c->p[k].key_path[0])
+            unlink(c->p[k].key_path);
         free(c->p[k].bye);
     }
     if (c->zctx)
@@ -776,6 +824,8 @@ int main(int argc, char **argv)
             st = fluid_params_read(&fp, c.cs, &err);
         if (!st && sc)
             st = solid_scene_read(sc, c.cs, &err);
+        if (!st && sc && c.p[FLUID].needed)
+            st = scene_check_fsi(&fp, sc, c.cs, &err);
         free(sc);
         if (st) {
             fprintf(stderr, "coupler: %s\n", err.msg);
@@ -822,10 +872,21 @@ int main(int argc, char **argv)
         if ((st = open_endpoint(&c, k, &err)))
             goto end;
         p->active = 1; /* listened to from now on */
+    }
+    /* every socket holds its copy of the server's secret key now */
+    memset(c.curve.server_secret, 0, sizeof c.curve.server_secret);
+    /* the ZAP handler answers before any solver is launched */
+    if (c.guard && (st = guard_start(c.guard, stderr, &err)))
+        goto end;
+    for (int k = 0; k < NPEERS; k++) {
+        struct peer *p = &c.p[k];
+        if (!p->needed)
+            continue;
         /* --solid/--fluid are already in the case (coupler_record_init) */
         const char *cmd = mps_case_string(c.cs, k == FLUID ? "fluid_solver" : "solid_solver");
         snprintf(p->child.command, sizeof p->child.command, "%s", cmd);
-        if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint, &err)))
+        if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint,
+                                               p->key_path[0] ? p->key_path : NULL, &err)))
             goto end;
         p->child.name = p->name;
     }
@@ -852,6 +913,14 @@ end:
     } else {
         for (int k = 0; k < NPEERS; k++)
             launch_reap(&c.p[k].child, 10.0);
+    }
+    if (c.guard) {
+        guard_stop(c.guard);
+        char who[512];
+        guard_describe(c.guard, who, sizeof who);
+        if (who[0])
+            fprintf(stderr, "coupler: refused %ld unauthenticated connection%s: %s\n",
+                    guard_refused(c.guard), guard_refused(c.guard) == 1 ? "" : "s", who);
     }
     if (c.cs && c.out) {
         write_summary(&c, st, &err);

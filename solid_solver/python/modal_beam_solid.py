@@ -20,7 +20,7 @@ coupler's scene.xmf shows the plate with the fluid. Failures are reported to
 the coupler as ERROR (PROTOCOL.md 8). tests/coupler/conformance.py checks it
 against the protocol.
 
-usage: modal_beam_solid.py [--courant C] --connect ENDPOINT
+usage: modal_beam_solid.py [--courant C] [--key FILE] --connect ENDPOINT
 """
 import json, math, os, sys, time
 
@@ -241,8 +241,14 @@ def main():
     args = sys.argv[1:]
     endpoint = args[args.index('--connect') + 1]
     courant = float(args[args.index('--courant') + 1]) if '--courant' in args else 0.5
+    key = args[args.index('--key') + 1] if '--key' in args else None
     ctx = zmq.Context()
-    sock = mp.connect(ctx, endpoint)
+    try:
+        sock = mp.connect(ctx, endpoint, key)  # tcp: CURVE (PROTOCOL.md section 10)
+    except (mp.ProtocolError, OSError, ValueError) as e:
+        print(f'modal_beam_solid: input: {e}', file=sys.stderr)
+        ctx.term()
+        return 2
     mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
     try:
         code = converse(sock, courant, time.time())
