@@ -134,6 +134,15 @@ static long count_inside(const struct solid_scene *s, int b, double x0, double y
     return k;
 }
 
+/* "plate, post": the bodies' names, for messages. */
+static const char *body_names(const struct solid_scene *s, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (int b = 0; b < s->nbodies; b++)
+        snprintf(buf + strlen(buf), len - strlen(buf), "%s%s", b ? ", " : "", s->bodies[b].name);
+    return buf;
+}
+
 static void copy_name(char *dst, const char *src)
 {
     snprintf(dst, SOLID_NAME_MAX, "%s", src);
@@ -241,11 +250,9 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             if (strcmp(s->bodies[b].name, name) == 0)
                 d->body = b;
         if (d->body < 0) {
-            char names[512] = "";
-            for (int b = 0; b < s->nbodies; b++)
-                snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
-                         b ? ", " : "", s->bodies[b].name);
-            return mps_case_fail(c, err, key, "no body of that name (bodies: %s)", names);
+            char names[512];
+            return mps_case_fail(c, err, key, "no body of that name (bodies: %s)",
+                                 body_names(s, names, sizeof names));
         }
         d->x0 = mps_case_double(c, "solid.clamps.%d.x0", k);
         d->y0 = mps_case_double(c, "solid.clamps.%d.y0", k);
@@ -304,8 +311,10 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             for (int b = 0; b < s->nbodies; b++)
                 if (strcmp(s->bodies[b].name, name) == 0)
                     d->body = b;
+            char names[512];
             if (d->body < 0)
-                return mps_case_fail(c, err, key, "no body of that name");
+                return mps_case_fail(c, err, key, "no body of that name (bodies: %s)",
+                                     body_names(s, names, sizeof names));
         }
         snprintf(key, sizeof key, "solid.probes.%d.name", k);
         for (int a = 0; a < k; a++)
