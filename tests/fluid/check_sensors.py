@@ -7,9 +7,9 @@ usage: check_sensors.py RUN --check hydrostatic [--dp 0.01] [--depth 0.3] [--wid
 hydrostatic: cases/hydrostatic's sensors (p_left_low 50 mm up the left wall,
   p_floor) and wall loads against still water whose surface sits at the top
   particles' centres, h' = h - dp/2, dp/2 below the water line (docs/fluid.md).
-dambreak: cases/dambreak's right-wall sensor (p_wall_16mm, centre 16 mm up)
+dambreak: cases/dambreak's right-wall sensor (p_wall, centre 16 mm up)
   sees the impact when the front reaches the wall; needs the probes front,
-  p_wall_16mm, force_right and h_wall (a height probe at the wall column).
+  p_wall, force_right and h_wall (a height probe at the wall column).
 means: the rows of COARSE_RUN (a longer output.probe_interval, the same run
   otherwise) are the dt-weighted means of RUN's rows over each of its
   intervals: the sensors are time means, not samples.
@@ -68,7 +68,7 @@ def hydrostatic(a):
 def dambreak(a):
     rows = rows_of(a.run)
     W, dp, y_s = a.width, a.dp, a.sensor_y
-    p = 'p_wall_16mm'
+    p = 'p_wall'
     # arrival: the front (leading particle + dp/2) within half a spacing of
     # the wall, i.e. its particle in contact with the wall's first layer
     arr = [r for r in rows if r['front'] >= W - 0.5 * dp]

@@ -1,6 +1,6 @@
 #!/bin/sh
 # The 8 mm dam break to 0.35 s, its probes every 2 ms and every 10 ms: the
-# right-wall sensor (cases/dambreak, p_wall_16mm) must see the impact when
+# right-wall sensor (cases/dambreak, p_wall) must see the impact when
 # the front reaches the wall, and the 10 ms rows of the sensor and the wall
 # force must be the time means of the 2 ms rows (check_sensors.py).
 # h_wall: the height of the water in the column next to the right wall.
@@ -15,4 +15,4 @@ for iv in 0.002 0.01; do
 done
 check="/usr/bin/python3 $(dirname "$0")/../check_sensors.py"
 $check "$out/iv0.002" --check dambreak --dp 0.008 || exit 1
-exec $check "$out/iv0.002" --check means --coarse "$out/iv0.01" --columns p_wall_16mm,force_right
+exec $check "$out/iv0.002" --check means --coarse "$out/iv0.01" --columns p_wall,force_right
