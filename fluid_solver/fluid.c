@@ -596,7 +596,10 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
                            "flow is too fast for the CFL condition (Eq. 52)",
                            dt, f->time, p->dt_min);
 
-    f->last = (struct fluid_step_stats){.dt = dt};
+    /* the step the CFL condition allows here: a step shortened below it
+     * (the last one, landing on end_time) scales Eq. 23's correction with
+     * it (fluid_ppe.c) */
+    f->last = (struct fluid_step_stats){.dt = dt, .dt_cfl = fluid_cfl_dt(f)};
     /* neighbours (Verlet list with skin) */
     mps_timer_switch(&f->timer, PH_NBR);
     if ((st = update_neighbours(f, err)))

@@ -35,6 +35,7 @@ enum fluid_phase {
 /* What the last step did, for the step log (fluid.step_log). */
 struct fluid_step_stats {
     double dt;
+    double dt_cfl;         /* the CFL step at the step's start (>= dt) */
     int ppe_iterations;
     int ppe_rows;
     int rows_at_zero;      /* PPE rows whose pressure came out <= 0 (clamped) */
