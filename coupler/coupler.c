@@ -571,7 +571,12 @@ static enum mps_status stop_all(struct coupler *c, struct mps_err *err)
     return MPS_OK;
 }
 
-static void abort_all(struct coupler *c, const char *reason)
+/* Sends ABORT to the solvers still running and waits for them together: 5 s
+ * for each to act on it, except a solver that missed its deadline (hung: it
+ * is not reading), which gets SIGTERM at once; SIGKILL 2 s after SIGTERM. A
+ * hang is then over within about 2 s of its deadline, not 7-12 s (one grace
+ * after the other, measured by coupler_solid_hang). */
+static void abort_all(struct coupler *c, const char *reason, int hung)
 {
     for (int k = 0; k < NPEERS; k++) {
         struct peer *p = &c->p[k];
@@ -587,8 +592,13 @@ static void abort_all(struct coupler *c, const char *reason)
         }
         p->active = 0;
     }
-    for (int k = 0; k < NPEERS; k++)
-        launch_reap(&c->p[k].child, 5.0);
+    struct child *kids[NPEERS];
+    double grace[NPEERS];
+    for (int k = 0; k < NPEERS; k++) {
+        kids[k] = &c->p[k].child;
+        grace[k] = k == hung ? 0.0 : 5.0;
+    }
+    launch_reap_all(kids, grace, NPEERS);
 }
 
 /* The number after "key": in a solver's summary JSON (its BYE), or def. */
@@ -909,10 +919,19 @@ int main(int argc, char **argv)
 end:
     if (st) {
         fprintf(stderr, "\ncoupler: %s: %s\n", mps_status_name(st), err.msg);
-        abort_all(&c, err.msg);
+        int hung = -1; /* the solver that missed a deadline, if that was the failure */
+        for (int k = 0; k < NPEERS && st == MPS_ETIMEOUT; k++)
+            if (strcmp(c.failed_peer, c.p[k].name) == 0)
+                hung = k;
+        abort_all(&c, err.msg, hung);
     } else {
-        for (int k = 0; k < NPEERS; k++)
-            launch_reap(&c.p[k].child, 10.0);
+        struct child *kids[NPEERS];
+        double grace[NPEERS];
+        for (int k = 0; k < NPEERS; k++) {
+            kids[k] = &c.p[k].child;
+            grace[k] = 10.0;
+        }
+        launch_reap_all(kids, grace, NPEERS);
     }
     if (c.guard) {
         guard_stop(c.guard);
