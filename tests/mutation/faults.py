@@ -284,7 +284,7 @@ FAULTS = [
       what="a solver waits ten times its deadline for a coupler that is silent",
       hint='proto_|conformance'),
     # ---- case files: bad input (common/mps_case*.c) ----
-    F(id='case_bounds_unchecked', eq='bad input: ranges', file='common/mps_case.c',
+    F(id='case_bounds_unchecked', eq='bad input: ranges', file='common/mps_case_keys.c',
       old='''        if (!in_bounds(s, v->d)) {
             bounds_text(s, prob, np);
             return -1;
