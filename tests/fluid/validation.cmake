@@ -19,7 +19,7 @@ set(FV_SOLVER ${CMAKE_BINARY_DIR}/bin/fluid_solver)
 
 # fluid_valid_hydrostatic: the bottom pressure against rho g (h - dp/2) (P = 0
 # at the surface particles' centres, dp/2 below the water line: -1.67% of
-# rho g h at 10 mm) within 0.5%: measured mean -0.04%, worst -0.19% over the
+# rho g h at 10 mm) within 0.5%: measured mean -0.05%, worst -0.08% over the
 # 2 s (the MPS pressure noise), identical with 1 and 2 threads and with
 # MPS_SIMD=sse2 (2026-12-02). A 3% band around rho g h (before) let a 1.3%
 # error of the physics through.
