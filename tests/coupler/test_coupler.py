@@ -240,6 +240,29 @@ def t_fluid_fails():
     after_failure(out, rc, err, 'fluid solver: solver:')
 
 
+TOY = os.path.join(ROOT, 'tests', 'coupler', 'conformance_toy_solid.py')
+
+
+def t_wrong_role():
+    """A solid whose HELLO says role=fluid is refused on the solid endpoint."""
+    out = tempfile.mkdtemp(prefix='cpl_role_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', f'/usr/bin/python3 {TOY} --bug role'])
+    check(rc != 0, f'coupler refuses the solid (exit {rc})')
+    check("this endpoint is for the solid solver, not 'fluid'" in err,
+          f'coupler says why: {err.strip()[-200:]!r}')
+
+
+def t_result_echo():
+    """A RESULT that echoes another step than the ADVANCE's is a protocol
+    error (PROTOCOL.md: RESULT echoes step and time), not this step's."""
+    out = tempfile.mkdtemp(prefix='cpl_echo_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', f'/usr/bin/python3 {TOY} --bug step',
+                   '--set', 'end_time=0.02'])
+    check(rc != 0, f'coupler stops on the wrong echo (exit {rc})')
+    check('solid RESULT is for step 1 at' in err and 'expected step 0' in err,
+          f'coupler names the steps: {err.strip()[-200:]!r}')
+
+
 def t_wrong_version():
     out = tempfile.mkdtemp(prefix='cpl_ver_')
     report = os.path.join(out, 'solver_report.txt')
