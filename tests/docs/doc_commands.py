@@ -100,6 +100,9 @@ SHORT = [
      'the elastica reference at N = 10, 20 (40, 80, 160: minutes)'),
     ('docs/solid_models.md', r'^\s*bench/solid_cantilever\.py --bin build/bin/solid_solver.*\\\n.*$',
      'true', 'the cantilever table of each model: minutes'),
+    ('docs/testing.md', r'^nice -n 10 /usr/bin/python3 tests/mutation/run\.py .*$',
+     '/usr/bin/python3 tests/mutation/run.py --check',
+     'the mutation check (hours: a build and tests per fault): only that every fault applies'),
 ]
 
 
