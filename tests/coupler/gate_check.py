@@ -10,7 +10,7 @@ thick, docs/elastic_gate.md) the solids peak at 3.66-4.14 cm at 0.111-0.123 s
 3.66 and 3.81 cm: 4% apart); the opening is driven by the column, and both
 coarse solids, two different discretisations of the same 2-particle gate,
 peak at 3.58-3.59 cm at 0.099-0.105 s (measured 2026-12-02, the same to 0.01 cm
-with 1 and 2 threads). The band is that value +-7%: the spread of the
+with 1 and 2 threads and MPS_SIMD=sse2). The band is that value +-7%: the spread of the
 consistent fine solids plus a margin. Then, at 0.15 s, the gate is
 closing (tip_dx below its peak), the end never goes down into the floor
 (tip_dy >= -2 mm) and it swings up on its arc (tip_dy > 0 at the peak).
