@@ -254,6 +254,82 @@ static void test_droplet_step(void)
     CHECK_NEAR(dts[1], 0.02 / 40.0, 1e-12);
 }
 
+/* Eq. 22-23 term by term on the assembled PPE of the dam break after 5
+ * steps (off the lattice: every row has a density deviation), with the
+ * paper's PPE walls and the density source, so each row holds the
+ * Laplacian's weights, the alpha P term and nothing else:
+ *   rhs_i = kappa rho / dt^2 (n_i - n0) / n0         (Eq. 23, as printed:
+ *           fluid.kappa_dt = 0; with kappa_dt > dt, kappa rho / (dt kappa_dt))
+ *   diag_i(alpha) - diag_i(0) = rho alpha / dt^2     (Eq. 22's alpha P moved
+ *           to the left, the sign that makes the matrix more diagonal). */
+static void test_ppe_terms(void)
+{
+    const char *sets[] = {"dp=0.02", "fluid.wall_bc=ppe", "fluid.ppe_source=density",
+                          "fluid.kappa_dt=0", "fluid.alpha=1e-6"};
+    struct fluid *f = make_stepped("cases/dambreak/case.yml", sets, 5, 5);
+    if (!f)
+        return;
+    const struct fluid_params *p = &f->prm;
+    struct mps_err err = {0};
+    const double dt = 1e-3;
+    CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
+    const int n = f->nrows;
+    double *diag = malloc((size_t)(n > 0 ? n : 1) * sizeof *diag);
+    CHECK(diag != NULL && n > 0);
+    if (!diag) {
+        fluid_destroy(&f);
+        return;
+    }
+    double worst = 0.0, big = 0.0;
+    int rows = 0, off = 0;
+    for (size_t i = 0; i < f->ps.n; i++) {
+        int r = f->row[i];
+        if (r < 0)
+            continue;
+        double want = p->kappa * p->rho / (dt * dt) * (f->nd[i] - f->n0) / f->n0;
+        worst = fmax(worst, fabs(f->rhs[r] - want));
+        big = fmax(big, fabs(want));
+        off += f->nd[i] != f->n0;
+        for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++)
+            if (f->col[k] == r)
+                diag[r] = f->val[k];
+        rows++;
+    }
+    printf("PPE source (Eq. 23): %d rows (%d off n0), |rhs - kappa rho/dt^2 dn/n0| <= %.3g of "
+           "%.3g\n", rows, off, worst, big);
+    CHECK(rows >= 50 && off > rows / 2);
+    CHECK(worst <= 1e-12 * big);
+    /* kappa_dt longer than the step: the fixed rate kappa / kappa_dt */
+    f->prm.kappa_dt = 4.0 * dt;
+    CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
+    worst = 0.0;
+    for (size_t i = 0; i < f->ps.n; i++)
+        if (f->row[i] >= 0)
+            worst = fmax(worst, fabs(f->rhs[f->row[i]] - p->kappa * p->rho / (dt * 4.0 * dt) *
+                                                           (f->nd[i] - f->n0) / f->n0));
+    CHECK(worst <= 1e-12 * big);
+    /* alpha on the diagonal */
+    f->prm.kappa_dt = 0.0;
+    const double alpha = f->prm.alpha;
+    f->prm.alpha = 0.0;
+    CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
+    double dworst = 0.0, comp = p->rho * alpha / (dt * dt);
+    for (size_t i = 0; i < f->ps.n; i++) {
+        int r = f->row[i];
+        if (r < 0)
+            continue;
+        for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++)
+            if (f->col[k] == r)
+                dworst = fmax(dworst, fabs(diag[r] - f->val[k] - comp));
+    }
+    printf("PPE diagonal: alpha adds rho alpha / dt^2 = %.4g to every row (worst %.3g off)\n",
+           comp, dworst);
+    CHECK(dworst <= 1e-9 * comp);
+    f->prm.alpha = alpha;
+    free(diag);
+    fluid_destroy(&f);
+}
+
 static void test_verlet_list(void)
 {
     const char *sets[] = {"dp=0.008"};
@@ -395,6 +471,7 @@ int main(int argc, char **argv)
     test_paper_walls();
     test_wall_modes();
     test_droplet_step();
+    test_ppe_terms();
     test_verlet_list();
     return test_summary("test_fluid_step");
 }
