@@ -263,6 +263,21 @@ def t_result_echo():
           f'coupler names the steps: {err.strip()[-200:]!r}')
 
 
+def t_solver_input_error():
+    """A solver that finds an input error the coupler could not see (here the
+    TLSPH model asked for fracture, which only the MPS model has) answers
+    ERROR "input: ..."; the coupler names it and exits 2, as for its own
+    input errors (PROTOCOL.md 8: the status travels with the ERROR)."""
+    out = tempfile.mkdtemp(prefix='cpl_input_')
+    rc, err = run(['cases/fracture_collision/case.yml', '--out', out, '--quiet', '--solid',
+                   'solid_solver --model tlsph', '--set', 'dp=0.05', '--set', 'end_time=0.01'],
+                  cwd=ROOT)
+    check(rc == 2, f'exit status {rc} (expected 2: an input error)')
+    check('coupler: input: solid solver: input:' in err and
+          'solid.eps_max = 0.2: fracture and contact are in the mps model only' in err,
+          f'the coupler names the solver, the key and the problem: {err.strip()[:300]!r}')
+
+
 def t_wrong_version():
     out = tempfile.mkdtemp(prefix='cpl_ver_')
     report = os.path.join(out, 'solver_report.txt')
