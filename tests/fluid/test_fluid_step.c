@@ -258,6 +258,8 @@ static void test_droplet_step(void)
  * steps (off the lattice: every row has a density deviation), with the
  * paper's PPE walls and the density source, so each row holds the
  * Laplacian's weights, the alpha P term and nothing else:
+ *   a_ij = -2d / (lambda n0) w(|x_j - x_i|)           (Eq. 12 with Eq. 7, 8, 13
+ *           on the lattice at re_lap, for every neighbour j that is a row)
  *   rhs_i = kappa rho / dt^2 (n_i - n0) / n0         (Eq. 23, as printed:
  *           fluid.kappa_dt = 0; with kappa_dt > dt, kappa rho / (dt kappa_dt))
  *   diag_i(alpha) - diag_i(0) = rho alpha / dt^2     (Eq. 22's alpha P moved
@@ -280,6 +282,37 @@ static void test_ppe_terms(void)
         fluid_destroy(&f);
         return;
     }
+    /* Eq. 12's coefficient from the lattice sums written out here */
+    const double re = p->re_lap * p->dp;
+    double sw = 0.0, sr2w = 0.0;
+    const int reach = (int)ceil(p->re_lap) + 1;
+    for (int a = -reach; a <= reach; a++)
+        for (int b = -reach; b <= reach; b++) {
+            double r = p->dp * sqrt((double)(a * a + b * b));
+            if ((a || b) && r < re) {
+                sw += re / r - 1.0;
+                sr2w += r * r * (re / r - 1.0);
+            }
+        }
+    const double lap_c = 2.0 * MPS_DIM / ((sr2w / sw) * sw);
+    size_t *part = malloc((size_t)n * sizeof *part);
+    CHECK(part != NULL);
+    for (size_t i = 0; part && i < f->ps.n; i++)
+        if (f->row[i] >= 0)
+            part[f->row[i]] = i;
+    double aworst = 0.0, abig = 0.0;
+    for (int r = 0; part && r < n; r++)
+        for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++) {
+            if (f->col[k] == r)
+                continue;
+            const double *xi = f->x[part[r]], *xj = f->x[part[f->col[k]]];
+            double w = mps_weight(hypot(xj[0] - xi[0], xj[1] - xi[1]), re);
+            aworst = fmax(aworst, fabs(f->val[k] + lap_c * w));
+            abig = fmax(abig, lap_c * w);
+        }
+    printf("PPE Laplacian (Eq. 12): |a_ij + 2d/(lambda n0) w_ij| <= %.3g of %.3g\n", aworst, abig);
+    CHECK(abig > 0.0 && aworst <= 1e-9 * abig);
+    free(part);
     double worst = 0.0, big = 0.0;
     int rows = 0, off = 0;
     for (size_t i = 0; i < f->ps.n; i++) {
