@@ -4,7 +4,7 @@ in each equation the code implements, the protocol's rejections and the
 coupler's failure handling? The faults are in tests/mutation/faults.py.
 
     nice -n 10 /usr/bin/python3 tests/mutation/run.py [--work DIR] [--only ID,ID]
-        [--all-tests] [--table FILE] [--check]
+        [--redo] [--baseline] [--all-tests] [--table FILE] [--check]
 
 It copies the repository (a clone of HEAD with the working tree's files laid
 over it: uncommitted changes count) to a scratch directory (default
@@ -20,8 +20,11 @@ restore the file. A fault caught by the compiler (CI builds with warnings
 as errors) counts as caught by 'build'. Tests that fail on the baseline are
 left out of every run (listed in the report).
 
-Results go to WORK/results.json as they come (a rerun skips the faults done
-unless --redo); --table FILE writes the markdown table for docs/testing.md.
+Results go to WORK/results.json as they come, each with the revision of the
+tree it ran on. A rerun lays the working tree over the scratch copy again
+and skips the faults done, unless --redo (with --only: those faults);
+--baseline runs the baseline again (after a change to the tests). --table
+FILE writes the markdown table for docs/testing.md.
 --check only verifies that every fault's text occurs once in its file.
 Exit status: 0 if every fault was caught, 1 otherwise."""
 import argparse
@@ -113,6 +116,15 @@ def prepare(work, log):
     return src, build
 
 
+def revision():
+    """HEAD of the tree the faults are applied to, '+' if it has changes."""
+    head = subprocess.run(['git', 'rev-parse', '--short', 'HEAD'], cwd=ROOT, capture_output=True,
+                          text=True).stdout.strip() or 'no-git'
+    dirty = subprocess.run(['git', 'status', '--porcelain', '--untracked-files=no'], cwd=ROOT,
+                           capture_output=True, text=True).stdout.strip()
+    return head + ('+' if dirty else '')
+
+
 def build_tree(build, log):
     return sh(['cmake', '--build', build, '-j2'], log=log) == 0
 
@@ -195,6 +207,7 @@ def main():
     ap.add_argument('--only', help='comma-separated fault ids')
     ap.add_argument('--all-tests', action='store_true', help='every fast test for every fault')
     ap.add_argument('--redo', action='store_true', help='run faults already in results.json')
+    ap.add_argument('--baseline', action='store_true', help='run the baseline again')
     ap.add_argument('--table', help='write the markdown table to this file')
     ap.add_argument('--check', action='store_true', help='only check that the faults apply')
     a = ap.parse_args()
@@ -208,13 +221,14 @@ def main():
     src, build = prepare(a.work, log)
     if not build_tree(build, log):
         sys.exit(f'mutation: the unmodified tree does not build, see {log}')
-    state = json.load(open(res_path)) if os.path.exists(res_path) else {}
-    if 'baseline' not in state or a.redo:
-        print('baseline: the fast suite on the unmodified tree ...', flush=True)
+    state = json.load(open(res_path)) if os.path.exists(res_path) else {'faults': {}}
+    rev = revision()
+    if 'baseline' not in state or a.baseline:
+        print(f'baseline: the fast suite on the unmodified tree ({rev}) ...', flush=True)
         t0 = time.time()
         r = ctest(build, log, FAST)
-        state = {'baseline': {'failed': failed(r), 'tests': len(r),
-                              'seconds': round(time.time() - t0)}, 'faults': {}}
+        state['baseline'] = {'failed': failed(r), 'tests': len(r), 'revision': rev,
+                             'seconds': round(time.time() - t0)}
         json.dump(state, open(res_path, 'w'), indent=1)
     base = state['baseline']
     print(f"baseline: {base['tests']} fast tests in {base['seconds']} s; failing (left out): "
@@ -226,11 +240,14 @@ def main():
         if f['id'] in state['faults'] and not a.redo:
             continue
         r = run_fault(f, src, build, log, set(base['failed']), a.all_tests)
+        r['revision'] = rev
         state['faults'][f['id']] = r
         json.dump(state, open(res_path, 'w'), indent=1)
         print(f"{f['id']:32s} {r['status']:9s} {', '.join(r['caught_by'])} "
               f"({r.get('seconds', 0):.0f} s)", flush=True)
     build_tree(build, log)  # the scratch build back to the unmodified tree
+    state['faults'] = {k: v for k, v in state['faults'].items()
+                       if any(f['id'] == k for f in FAULTS)}  # faults since removed
     caught, done, md = table(state['faults'])
     print(f'\nscore: {caught} of {done} faults caught')
     if a.table:
