@@ -278,6 +278,22 @@ def t_solver_input_error():
           f'the coupler names the solver, the key and the problem: {err.strip()[:300]!r}')
 
 
+def t_summary_unwritable():
+    """A run whose record cannot be written does not end as a success: with
+    OUT/solid_summary.json taken by a directory, the coupler names the file
+    and exits 1 (io), and still writes what it can (summary.json, the
+    fluid's summary). It used to drop the solver's summary without a word."""
+    out = tempfile.mkdtemp(prefix='cpl_summary_')
+    os.mkdir(os.path.join(out, 'solid_summary.json'))
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid', '--set', 'end_time=0.02'])
+    check(rc == 1, f'exit status {rc} (expected 1: io)')
+    check('coupler: io: ' in err and 'solid_summary.json: cannot open for writing' in err,
+          f'the coupler names the file: {err.strip()[-300:]!r}')
+    s = json.load(open(os.path.join(out, 'summary.json')))
+    check(s['status'] == 'ok' and s['coupling_steps'] > 0, 'summary.json written for the run')
+    check(os.path.isfile(os.path.join(out, 'fluid_summary.json')), 'the fluid\'s summary written')
+
+
 def t_wrong_version():
     out = tempfile.mkdtemp(prefix='cpl_ver_')
     report = os.path.join(out, 'solver_report.txt')
