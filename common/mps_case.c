@@ -221,6 +221,8 @@ enum mps_status mps_case_load(struct mps_case **out, const char *path,
     }
 
     enum mps_status st = case_read_file(c, err);
+    if (st == MPS_OK)
+        st = case_read_origins(c, err);
     struct errs es = {err, 0, ""};
     for (int i = 0; i < nsets && st == MPS_OK; i++)
         if (case_apply_set(c, sets[i], &es) == MPS_ENOMEM)

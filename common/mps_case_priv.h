@@ -104,6 +104,19 @@ enum mps_status case_validate(struct mps_case *c, struct errs *es);
 /* Writes "; did you mean fluid.blocks.0.x0?" (with key's own indices) or "". */
 void case_suggest(const struct mps_case *c, const char *key, char *out, size_t n);
 
+/* ---- the resolved file (mps_case_resolved.c) ---- */
+/* Its first line, and the comment lines after the YAML that say where each
+ * key came from and its value there ("#@ fluid.rho<TAB>case.yml:14<TAB>1000";
+ * the origin is also "--set dp=0.01" or "default"). */
+#define RESOLVED_INTRO "# Resolved from "
+#define ORIGIN_INTRO "# Where each key was given (a program that reads this file names those places):\n"
+#define ORIGIN_MARK "#@ "
+/* For a resolved file (first line RESOLVED_INTRO), gives each key that
+ * still has the value of its ORIGIN_MARK line that line's origin, so a
+ * program that finds a problem in the copy names the user's file and line or
+ * --set; other files: nothing. */
+enum mps_status case_read_origins(struct mps_case *c, struct mps_err *err);
+
 /* ---- reading (mps_case_yaml.c) and --set (mps_case_set.c) ---- */
 /* The case file c->path into the table; fatal errors in err. */
 enum mps_status case_read_file(struct mps_case *c, struct mps_err *err);

@@ -1,11 +1,14 @@
 /* The resolved case: every key, defaults included, nested back into YAML
- * (mps_case_resolved_yaml, mps_case_write_resolved in mps_case.h). */
+ * (mps_case_resolved_yaml, mps_case_write_resolved in mps_case.h), with
+ * where each key came from, which mps_case_load reads back
+ * (case_read_origins). */
 #include "mps_case_priv.h"
 
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/types.h>
 
 #include <yaml.h>
 
@@ -135,6 +138,66 @@ char *mps_case_resolved_yaml(const struct mps_case *c)
     return out.s;
 }
 
+/* The comment lines that carry each key's origin: "#@ KEY<TAB>WHERE<TAB>
+ * VALUE". The value is there so an origin is used only while the copy holds
+ * the value given there (someone may edit the copy and run it again). A
+ * key, origin or value holding a line break (a --set value can), or a key
+ * or origin holding a tab, is left out: the reader then names the resolved
+ * file's line for it. */
+static int write_origins(FILE *f, const struct mps_case *c)
+{
+    int bad = fputs(ORIGIN_INTRO, f) < 0;
+    for (int i = 0; i < c->n && !bad; i++)
+        if (!strpbrk(c->e[i].key, "\t\r\n") && !strpbrk(c->e[i].where, "\t\r\n") &&
+            !strpbrk(c->e[i].val, "\r\n"))
+            bad = fprintf(f, "%s%s\t%s\t%s\n", ORIGIN_MARK, c->e[i].key, c->e[i].where,
+                          c->e[i].val) < 0;
+    return bad;
+}
+
+enum mps_status case_read_origins(struct mps_case *c, struct mps_err *err)
+{
+    FILE *f = fopen(c->path, "r");
+    if (!f) /* it was read a moment ago: gone now */
+        return mps_err_set(err, MPS_EIO, "%s: cannot read: %s", c->path, strerror(errno));
+    char *line = NULL;
+    size_t cap = 0;
+    ssize_t n;
+    int first = 1, marks = 0;
+    enum mps_status st = MPS_OK;
+    while ((n = getline(&line, &cap, f)) > 0) {
+        if (first && strncmp(line, RESOLVED_INTRO, strlen(RESOLVED_INTRO)) != 0)
+            break; /* not a resolved case: its keys are where the file has them */
+        first = 0;
+        if (strncmp(line, ORIGIN_MARK, strlen(ORIGIN_MARK)) != 0)
+            continue;
+        if (++marks > c->n)
+            break; /* more origins than keys: not ours, and no quadratic work */
+        line[strcspn(line, "\r\n")] = '\0';
+        char *key = line + strlen(ORIGIN_MARK), *at = strchr(key, '\t');
+        char *val = at ? strchr(at + 1, '\t') : NULL;
+        if (!val)
+            continue;
+        *at++ = '\0';
+        *val++ = '\0';
+        struct entry *e = case_find_entry(c, key);
+        if (e && strcmp(e->val, val) != 0)
+            e = NULL; /* edited since: the copy's line is where it was given */
+        char *where = e ? strdup(at) : NULL;
+        if (e && !where) {
+            st = mps_err_set(err, MPS_ENOMEM, "%s: out of memory", c->path);
+            break;
+        }
+        if (e) {
+            free(e->where);
+            e->where = where;
+        }
+    }
+    free(line);
+    fclose(f); /* read only: nothing to lose */
+    return st;
+}
+
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
                                         const char *comment, struct mps_err *err)
 {
@@ -152,8 +215,9 @@ enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *pa
         st = mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", tmp, strerror(errno));
         goto done;
     }
-    int bad = fprintf(f, "# Resolved from %s (defaults filled in, --set applied)\n%s%s", c->path,
+    int bad = fprintf(f, RESOLVED_INTRO "%s (defaults filled in, --set applied)\n%s%s", c->path,
                       comment ? comment : "", y) < 0;
+    bad |= write_origins(f, c);
     bad |= fclose(f) != 0;
     if (bad) {
         st = mps_err_set(err, MPS_EIO, "%s: cannot write: %s", tmp, strerror(errno));
