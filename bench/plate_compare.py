@@ -76,6 +76,11 @@ def main():
     ap.add_argument('--peak-band', nargs=2, type=float)
     ap.add_argument('--peak-time', nargs=2, type=float)
     ap.add_argument('--max-after', nargs=2, type=float)
+    ap.add_argument('--inside-min', type=float,
+                    help='fail if the run is inside the references\' envelope less than this '
+                         'fraction of [0, tmax]')
+    ap.add_argument('--rms-max', type=float,
+                    help='fail if the RMS difference from Walhorn\'s FEM curve exceeds this (m)')
     ap.add_argument('--json', action='store_true')
     a = ap.parse_args()
     ref = load_ref()
@@ -85,6 +90,10 @@ def main():
         if a.peak_band and not (a.peak_band[0] <= m['peak_m'] <= a.peak_band[1]):
             ok = False
         if a.peak_time and not (a.peak_time[0] <= m['peak_time_s'] <= a.peak_time[1]):
+            ok = False
+        if a.inside_min is not None and m['inside_reference_envelope'] < a.inside_min:
+            ok = False
+        if a.rms_max is not None and m['rms_vs_walhorn_m'] > a.rms_max:
             ok = False
         if a.max_after:
             t, d = load_run(m['run'])

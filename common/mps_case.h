@@ -101,8 +101,11 @@ char *mps_case_resolved_yaml(const struct mps_case *c);
 /* Writes the resolved configuration to path as a YAML file that
  * mps_case_load reads back to the same values (used by the coupler to hand
  * one resolved case to every solver), after a comment line naming the case
- * and the comment lines given (each "# ...\n"; NULL: none). Written through
- * path.tmp and rename(), so a reader never sees half a file. */
+ * and the comment lines given (each "# ...\n"; NULL: none), and followed by
+ * comment lines saying where each key was given, which mps_case_load reads
+ * back too: a solver's message about a key of the copy names the user's
+ * "case.yml:14" or "--set KEY=VALUE", as the coupler's would. Written
+ * through path.tmp and rename(), so a reader never sees half a file. */
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
                                         const char *comment, struct mps_err *err);
 

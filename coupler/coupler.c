@@ -30,6 +30,7 @@
 #include "mps_h5.h"
 #include "mps_host.h"
 #include "mps_json.h"
+#include "mps_json_read.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_prov.h"
@@ -566,12 +567,20 @@ static enum mps_status stop_all(struct coupler *c, struct mps_err *err)
             return st;
         p->bye = m.text ? strdup(m.text) : NULL;
         proto_msg_clear(&m);
+        if (!p->bye)
+            return mps_err_set(err, MPS_ENOMEM, "no memory to keep the %s solver's summary",
+                               p->name);
         p->active = 0;
     }
     return MPS_OK;
 }
 
-static void abort_all(struct coupler *c, const char *reason)
+/* Sends ABORT to the solvers still running and waits for them together: 5 s
+ * for each to act on it, except a solver that missed its deadline (hung: it
+ * is not reading), which gets SIGTERM at once; SIGKILL 2 s after SIGTERM. A
+ * hang is then over within about 2 s of its deadline, not 7-12 s (one grace
+ * after the other, measured by coupler_solid_hang). */
+static void abort_all(struct coupler *c, const char *reason, int hung)
 {
     for (int k = 0; k < NPEERS; k++) {
         struct peer *p = &c->p[k];
@@ -587,30 +596,40 @@ static void abort_all(struct coupler *c, const char *reason)
         }
         p->active = 0;
     }
-    for (int k = 0; k < NPEERS; k++)
-        launch_reap(&c->p[k].child, 5.0);
+    struct child *kids[NPEERS];
+    double grace[NPEERS];
+    for (int k = 0; k < NPEERS; k++) {
+        kids[k] = &c->p[k].child;
+        grace[k] = k == hung ? 0.0 : 5.0;
+    }
+    launch_reap_all(kids, grace, NPEERS);
 }
 
-/* The number after "key": in a solver's summary JSON (its BYE), or def. */
+/* The top-level member key of a solver's summary JSON (its BYE), or def
+ * when it has none (a third-party solver need not report it). */
 static double bye_number(const struct peer *p, const char *key, double def)
 {
-    char quoted[96];
-    snprintf(quoted, sizeof quoted, "\"%s\"", key);
-    const char *s = p->bye ? strstr(p->bye, quoted) : NULL;
-    if (s && (s = strchr(s + strlen(quoted), ':')))
-        return strtod(s + 1, NULL);
-    return def;
+    double v;
+    return p->bye && mps_json_top_number(p->bye, key, &v) == 1 ? v : def;
 }
 
-static void write_summary(struct coupler *c, enum mps_status st, const struct mps_err *err)
+/* Writes text and a newline to path: MPS_EIO naming it if it cannot. */
+static enum mps_status write_text(const char *path, const char *text, struct mps_err *err)
 {
-    char path[4200];
-    snprintf(path, sizeof path, "%s/summary.json", c->out);
-    FILE *fp = fopen(path, "w");
-    if (!fp) {
-        fprintf(stderr, "coupler: warning: cannot write %s\n", path);
-        return;
-    }
+    FILE *f = fopen(path, "w");
+    if (!f)
+        return mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", path,
+                           strerror(errno));
+    int bad = fputs(text, f) < 0 || fputc('\n', f) == EOF;
+    bad |= fclose(f) != 0;
+    if (bad)
+        return mps_err_set(err, MPS_EIO, "%s: cannot write: %s", path, strerror(errno));
+    return MPS_OK;
+}
+
+static void write_summary_json(struct coupler *c, enum mps_status st, const struct mps_err *err,
+                               FILE *fp)
+{
     double wall = mps_wall_seconds() - c->wall0;
     struct mps_json j;
     mps_json_begin(&j, fp);
@@ -670,18 +689,38 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     }
     mps_json_close(&j);
     mps_json_end(&j);
-    fclose(fp);
+}
+
+/* OUT/summary.json (the run's status st with its message err) and each
+ * solver's own summary verbatim beside it. A file that cannot be written is
+ * an MPS_EIO in werr (the first one), the others are still tried. */
+static enum mps_status write_summary(struct coupler *c, enum mps_status st,
+                                     const struct mps_err *err, struct mps_err *werr)
+{
+    char path[4200];
+    snprintf(path, sizeof path, "%s/summary.json", c->out);
+    enum mps_status wst = MPS_OK;
+    FILE *fp = fopen(path, "w");
+    if (!fp)
+        wst = mps_err_set(werr, MPS_EIO, "%s: cannot open for writing: %s", path,
+                          strerror(errno));
+    else
+        write_summary_json(c, st, err, fp);
+    if (fp) {
+        int bad = ferror(fp);
+        bad |= fclose(fp) != 0;
+        if (bad)
+            wst = mps_err_set(werr, MPS_EIO, "%s: cannot write: %s", path, strerror(errno));
+    }
     /* the solvers' own summaries, verbatim */
     for (int k = 0; k < NPEERS; k++)
         if (c->p[k].bye) {
+            struct mps_err e;
             snprintf(path, sizeof path, "%s/%s_summary.json", c->out, c->p[k].name);
-            FILE *f = fopen(path, "w");
-            if (f) {
-                fputs(c->p[k].bye, f);
-                fputc('\n', f);
-                fclose(f);
-            }
+            if (write_text(path, c->p[k].bye, &e) && !wst)
+                wst = mps_err_set(werr, MPS_EIO, "%s", e.msg);
         }
+    return wst;
 }
 
 static void write_scene(struct coupler *c)
@@ -724,53 +763,230 @@ static void cleanup(struct coupler *c)
 }
 
 /* Refuses an option that names a solver the case does not need: it would
- * otherwise be ignored without a word (exit 2). */
-static int refuse_unneeded(const struct coupler *c, const char *option, const char *value,
-                           int peer, const char *case_path)
+ * otherwise be ignored without a word (input error). */
+static enum mps_status refuse_unneeded(const struct coupler *c, const char *option,
+                                       const char *value, int peer, const char *case_path,
+                                       struct mps_err *err)
 {
     if (!value || c->p[peer].needed)
-        return 0;
-    fprintf(stderr, "coupler: %s %s: %s has no %s (%s), so no %s program runs; drop the option "
-                    "or choose a case with a %s\n",
-            option, value, case_path, c->p[peer].name,
-            peer == FLUID ? "fluid.tank" : "solid.bodies", c->p[peer].name, c->p[peer].name);
-    return 1;
+        return MPS_OK;
+    return mps_err_set(err, MPS_EINPUT, "%s %s: %s has no %s (%s), so no %s program runs; drop "
+                       "the option or choose a case with a %s", option, value, case_path,
+                       c->p[peer].name, peer == FLUID ? "fluid.tank" : "solid.bodies",
+                       c->p[peer].name, c->p[peer].name);
 }
 
-int main(int argc, char **argv)
+enum { OPT_SOLID, OPT_FLUID, OPT_EXTERNAL, NOPTS };
+
+/* The command line into cli and opt (--solid, --fluid, --external). Returns
+ * -1 to go on, or the exit status (--help, --version, a usage error). */
+static int read_command_line(int argc, char **argv, struct mps_cli *cli,
+                             struct mps_cli_extra opt[NOPTS])
 {
-    mps_prov_init(argc, argv);
-    struct mps_err err = {0};
-    struct mps_cli cli;
-    struct mps_cli_extra extra[] = {
-        {"--solid", 1, "solid program command (sets the case key solid_solver; refused "
-                       "for a case without a solid)", NULL},
-        {"--fluid", 1, "fluid program command (sets the case key fluid_solver; refused "
-                       "for a case without a fluid)", NULL},
-        {"--external", 1, "fluid|solid: do not launch it; wait for it to connect", NULL},
-    };
     const char *usage =
         "usage: coupler CASE.yml --out DIR [--set key=value]... [--quiet]\n"
         "               [--solid \"COMMAND\"] [--fluid \"COMMAND\"] [--external fluid|solid]";
-    enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 3, usage, &err);
+    struct mps_err err = {0};
+    enum mps_status st = mps_cli_parse(cli, argc, argv, opt, NOPTS, usage, &err);
     if (st == MPS_EINTR)
         return 0;
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
         return mps_status_exit_code(st);
     }
+    if (!cli->out_dir) {
+        /* no silent ./out: a second run there would mix with the first */
+        fprintf(stderr, "coupler: missing --out DIR (see --help)\n");
+        return 2;
+    }
+    return -1;
+}
+
+/* Loads and checks the case (every key, the solvers' cross-key checks) and
+ * decides which solvers run, before anything is written or launched. */
+static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
+                                 const struct mps_cli_extra opt[NOPTS], struct mps_err *err)
+{
+    enum mps_status st = mps_case_load(&c->cs, cli->case_path, c->rec.sets, c->rec.nsets,
+                                       c->tables, 4, NULL, err);
+    if (st)
+        return st;
+    c->hello_timeout = mps_case_double(c->cs, "coupling.hello_timeout");
+    c->ready_timeout = mps_case_double(c->cs, "coupling.ready_timeout");
+    c->step_timeout = mps_case_double(c->cs, "coupling.step_timeout");
+    /* Model only what the scene needs: launch a solver only if the case has
+     * its part. */
+    c->p[FLUID].needed = mps_case_has(c->cs, "fluid.tank.width");
+    c->p[SOLID].needed = mps_case_count(c->cs, "solid.bodies") > 0;
+    const char *ext = opt[OPT_EXTERNAL].value;
+    if (ext && strcmp(ext, "fluid") && strcmp(ext, "solid"))
+        return mps_err_set(err, MPS_EINPUT, "--external %s: must be fluid or solid", ext);
+    if (!c->p[FLUID].needed && !c->p[SOLID].needed)
+        return mps_err_set(err, MPS_EINPUT, "%s: the case has neither a fluid (fluid.tank) nor "
+                           "a solid (solid.bodies)", cli->case_path);
+    if ((st = refuse_unneeded(c, "--solid", opt[OPT_SOLID].value, SOLID, cli->case_path, err)) ||
+        (st = refuse_unneeded(c, "--fluid", opt[OPT_FLUID].value, FLUID, cli->case_path, err)) ||
+        (st = refuse_unneeded(c, "--external", ext, ext && !strcmp(ext, "solid") ? SOLID : FLUID,
+                              cli->case_path, err)))
+        return st;
+    for (int k = 0; k < NPEERS; k++)
+        c->p[k].external = ext && strcmp(ext, c->p[k].name) == 0;
+
+    /* The solvers' cross-key checks (a block outside the tank, an empty clamp,
+     * ...) run here too, so an error names the user's file or --set, not the
+     * resolved copy, and nothing is launched for a case that cannot run. */
+    struct fluid_params fp;
+    struct solid_scene *sc = c->p[SOLID].needed ? malloc(sizeof *sc) : NULL;
+    if (c->p[SOLID].needed && !sc)
+        st = mps_err_set(err, MPS_ENOMEM, "coupler: out of memory");
+    else if (c->p[FLUID].needed)
+        st = fluid_params_read(&fp, c->cs, err);
+    if (!st && sc)
+        st = solid_scene_read(sc, c->cs, err);
+    if (!st && sc && c->p[FLUID].needed)
+        st = scene_check_fsi(&fp, sc, c->cs, err);
+    free(sc);
+    return st;
+}
+
+/* Writes the run's record, opens the endpoints, launches the solvers and
+ * takes each through HELLO, CONFIG and READY; opens the probes. */
+static enum mps_status start_run(struct coupler *c, struct mps_err *err)
+{
+    const char *resolved = c->rec.path;
+    enum mps_status st = mps_mkdir_p(c->out, err);
+    if (st)
+        return st;
+    char abs_out[4096];
+    if (!mps_realpath(c->out, abs_out, sizeof abs_out))
+        return mps_err_set(err, MPS_EIO, "%s: %s", c->out, strerror(errno));
+    snprintf(c->rec.path, sizeof c->rec.path, "%s/case_resolved.yml", abs_out);
+    /* written now, so a run that fails to start leaves it too; rewritten as
+     * each solver says hello (coupler_record_hello) */
+    if ((st = coupler_record_write(&c->rec, c->cs, err)))
+        return st;
+    snprintf(c->rundir, sizeof c->rundir, "/tmp/mpsfsi-XXXXXX");
+    if (!mkdtemp(c->rundir)) {
+        c->rundir[0] = '\0';
+        return mps_err_set(err, MPS_EIO, "cannot create a run directory in /tmp: %s",
+                           strerror(errno));
+    }
+    /* before the first socket: ZeroMQ's I/O threads inherit the placement */
+    launch_share_cpu(strcmp(mps_case_string(c->cs, "coupling.pin_cpus"), "auto") == 0,
+                     c->cpu_note, sizeof c->cpu_note);
+    c->zctx = zmq_ctx_new();
+    if (!c->zctx)
+        return mps_err_set(err, MPS_ELIB, "zmq_ctx_new: %s", zmq_strerror(zmq_errno()));
+    for (int k = 0; k < NPEERS; k++) {
+        if (!c->p[k].needed)
+            continue;
+        if ((st = open_endpoint(c, k, err)))
+            return st;
+        c->p[k].active = 1; /* listened to from now on */
+    }
+    /* every socket holds its copy of the server's secret key now */
+    memset(c->curve.server_secret, 0, sizeof c->curve.server_secret);
+    /* the ZAP handler answers before any solver is launched */
+    if (c->guard && (st = guard_start(c->guard, stderr, err)))
+        return st;
+    for (int k = 0; k < NPEERS; k++) {
+        struct peer *p = &c->p[k];
+        if (!p->needed)
+            continue;
+        /* --solid/--fluid are already in the case (coupler_record_init) */
+        const char *cmd = mps_case_string(c->cs, k == FLUID ? "fluid_solver" : "solid_solver");
+        snprintf(p->child.command, sizeof p->child.command, "%s", cmd);
+        if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint,
+                                               p->key_path[0] ? p->key_path : NULL, err)))
+            return st;
+        p->child.name = p->name;
+    }
+    /* one solver at a time, so the only message that can come unasked is an
+     * ERROR; the solid first, so the model its HELLO names is in the case
+     * file before the fluid reads it (coupler_record_hello) */
+    for (int q = NPEERS - 1; q >= 0; q--)
+        if (c->p[q].needed &&
+            ((st = handshake(c, q, resolved, err)) || (st = await_ready(c, q, err))))
+            return st;
+    if ((st = open_probes(c, err)))
+        return st;
+    if (!c->quiet)
+        fprintf(stderr, "coupler: %s%s%s, output in %s\n", c->p[FLUID].needed ? "fluid" : "",
+                c->p[FLUID].needed && c->p[SOLID].needed ? " + " : "",
+                c->p[SOLID].needed ? "solid" : "", c->out);
+    return MPS_OK;
+}
+
+/* After the run (st: how it went, err its message): aborts or reaps the
+ * solvers, reports refused connections, writes the summaries and the
+ * scene. Returns the run's status, or MPS_EIO if the run went well but its
+ * summary could not be written (err says which file). */
+static enum mps_status finish_run(struct coupler *c, enum mps_status st, struct mps_err *err)
+{
+    if (st) {
+        fprintf(stderr, "\ncoupler: %s: %s\n", mps_status_name(st), err->msg);
+        int hung = -1; /* the solver that missed a deadline, if that was the failure */
+        for (int k = 0; k < NPEERS && st == MPS_ETIMEOUT; k++)
+            if (strcmp(c->failed_peer, c->p[k].name) == 0)
+                hung = k;
+        abort_all(c, err->msg, hung);
+    } else {
+        struct child *kids[NPEERS];
+        double grace[NPEERS];
+        for (int k = 0; k < NPEERS; k++) {
+            kids[k] = &c->p[k].child;
+            grace[k] = 10.0;
+        }
+        launch_reap_all(kids, grace, NPEERS);
+    }
+    if (c->guard) {
+        guard_stop(c->guard);
+        char who[512];
+        guard_describe(c->guard, who, sizeof who);
+        if (who[0])
+            fprintf(stderr, "coupler: refused %ld unauthenticated connection%s: %s\n",
+                    guard_refused(c->guard), guard_refused(c->guard) == 1 ? "" : "s", who);
+    }
+    struct mps_err werr;
+    if (write_summary(c, st, err, &werr)) {
+        /* a failed run keeps its own status; a finished one fails here, since
+         * its record is incomplete */
+        fprintf(stderr, "coupler: %s%s\n", st ? "also: " : "io: ", werr.msg);
+        if (!st)
+            st = mps_err_set(err, MPS_EIO, "%s", werr.msg);
+    }
+    write_scene(c);
+    long lost = (long)bye_number(&c->p[FLUID], "lost_particles", 0);
+    if (lost > 0) /* a result, not progress: --quiet keeps it */
+        fprintf(stderr, "coupler: %ld fluid particle%s left over the open tank walls "
+                        "(removed; lost_particles in summary.json)\n",
+                lost, lost == 1 ? "" : "s");
+    return st;
+}
+
+int main(int argc, char **argv)
+{
+    mps_prov_init(argc, argv);
+    struct mps_cli cli;
+    struct mps_cli_extra opt[NOPTS] = {
+        [OPT_SOLID] = {"--solid", 1, "solid program command (sets the case key solid_solver; "
+                                     "refused for a case without a solid)", NULL},
+        [OPT_FLUID] = {"--fluid", 1, "fluid program command (sets the case key fluid_solver; "
+                                     "refused for a case without a fluid)", NULL},
+        [OPT_EXTERNAL] = {"--external", 1, "fluid|solid: do not launch it; wait for it to "
+                                           "connect", NULL},
+    };
+    int rc = read_command_line(argc, argv, &cli, opt);
+    if (rc >= 0)
+        return rc;
     signal(SIGPIPE, SIG_IGN);
     struct sigaction sa = {0};
     sa.sa_handler = on_signal; /* no SA_RESTART: waits return on Ctrl-C */
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    if (!cli.out_dir) {
-        /* no silent ./out: a second run there would mix with the first */
-        fprintf(stderr, "coupler: missing --out DIR (see --help)\n");
-        return 2;
-    }
     struct coupler c = {0};
+    struct mps_err err = {0};
     c.out = cli.out_dir;
     c.quiet = cli.quiet;
     c.wall0 = mps_wall_seconds();
@@ -779,158 +995,16 @@ int main(int argc, char **argv)
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
                                                  solid_case_keys, coupler_case_keys};
     c.tables = tables;
-    coupler_record_init(&c.rec, &cli, extra[0].value, extra[1].value);
-    st = mps_case_load(&c.cs, cli.case_path, c.rec.sets, c.rec.nsets, tables, 4, NULL, &err);
+    coupler_record_init(&c.rec, &cli, opt[OPT_SOLID].value, opt[OPT_FLUID].value);
+    enum mps_status st = load_case(&c, &cli, opt, &err);
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
+        mps_case_destroy(&c.cs);
         return mps_status_exit_code(st);
     }
-    c.hello_timeout = mps_case_double(c.cs, "coupling.hello_timeout");
-    c.ready_timeout = mps_case_double(c.cs, "coupling.ready_timeout");
-    c.step_timeout = mps_case_double(c.cs, "coupling.step_timeout");
-    /* Model only what the scene needs: launch a solver only if the case has
-     * its part. */
-    c.p[FLUID].needed = mps_case_has(c.cs, "fluid.tank.width");
-    c.p[SOLID].needed = mps_case_count(c.cs, "solid.bodies") > 0;
-    const char *ext = extra[2].value;
-    if (ext && strcmp(ext, "fluid") && strcmp(ext, "solid")) {
-        fprintf(stderr, "coupler: --external %s: must be fluid or solid\n", ext);
-        mps_case_destroy(&c.cs);
-        return 2;
-    }
-    if (!c.p[FLUID].needed && !c.p[SOLID].needed) {
-        fprintf(stderr, "coupler: %s: the case has neither a fluid (fluid.tank) nor a solid "
-                        "(solid.bodies)\n", cli.case_path);
-        mps_case_destroy(&c.cs);
-        return 2;
-    }
-    if (refuse_unneeded(&c, "--solid", extra[0].value, SOLID, cli.case_path) ||
-        refuse_unneeded(&c, "--fluid", extra[1].value, FLUID, cli.case_path) ||
-        refuse_unneeded(&c, "--external", ext, ext && !strcmp(ext, "solid") ? SOLID : FLUID,
-                        cli.case_path)) {
-        mps_case_destroy(&c.cs);
-        return 2;
-    }
-
-    /* The solvers' cross-key checks (a block outside the tank, an empty clamp,
-     * ...) run here too, so an error names the user's file or --set, not the
-     * resolved copy, and nothing is launched for a case that cannot run. */
-    {
-        struct fluid_params fp;
-        struct solid_scene *sc = c.p[SOLID].needed ? malloc(sizeof *sc) : NULL;
-        if (c.p[SOLID].needed && !sc)
-            st = mps_err_set(&err, MPS_ENOMEM, "coupler: out of memory");
-        else if (c.p[FLUID].needed)
-            st = fluid_params_read(&fp, c.cs, &err);
-        if (!st && sc)
-            st = solid_scene_read(sc, c.cs, &err);
-        if (!st && sc && c.p[FLUID].needed)
-            st = scene_check_fsi(&fp, sc, c.cs, &err);
-        free(sc);
-        if (st) {
-            fprintf(stderr, "coupler: %s\n", err.msg);
-            mps_case_destroy(&c.cs);
-            return mps_status_exit_code(st);
-        }
-    }
-
-    const char *resolved = c.rec.path;
-    if ((st = mps_mkdir_p(c.out, &err)))
-        goto end;
-    {
-        char abs_out[4096];
-        if (!mps_realpath(c.out, abs_out, sizeof abs_out)) {
-            st = mps_err_set(&err, MPS_EIO, "%s: %s", c.out, strerror(errno));
-            goto end;
-        }
-        snprintf(c.rec.path, sizeof c.rec.path, "%s/case_resolved.yml", abs_out);
-    }
-    /* written now, so a run that fails to start leaves it too; rewritten as
-     * each solver says hello (coupler_record_hello) */
-    if ((st = coupler_record_write(&c.rec, c.cs, &err)))
-        goto end;
-    snprintf(c.rundir, sizeof c.rundir, "/tmp/mpsfsi-XXXXXX");
-    if (!mkdtemp(c.rundir)) {
-        c.rundir[0] = '\0';
-        st = mps_err_set(&err, MPS_EIO, "cannot create a run directory in /tmp: %s",
-                         strerror(errno));
-        goto end;
-    }
-    /* before the first socket: ZeroMQ's I/O threads inherit the placement */
-    launch_share_cpu(strcmp(mps_case_string(c.cs, "coupling.pin_cpus"), "auto") == 0,
-                     c.cpu_note, sizeof c.cpu_note);
-    c.zctx = zmq_ctx_new();
-    if (!c.zctx) {
-        st = mps_err_set(&err, MPS_ELIB, "zmq_ctx_new: %s", zmq_strerror(zmq_errno()));
-        goto end;
-    }
-    for (int k = 0; k < NPEERS; k++) {
-        struct peer *p = &c.p[k];
-        if (!p->needed)
-            continue;
-        p->external = ext && strcmp(ext, p->name) == 0;
-        if ((st = open_endpoint(&c, k, &err)))
-            goto end;
-        p->active = 1; /* listened to from now on */
-    }
-    /* every socket holds its copy of the server's secret key now */
-    memset(c.curve.server_secret, 0, sizeof c.curve.server_secret);
-    /* the ZAP handler answers before any solver is launched */
-    if (c.guard && (st = guard_start(c.guard, stderr, &err)))
-        goto end;
-    for (int k = 0; k < NPEERS; k++) {
-        struct peer *p = &c.p[k];
-        if (!p->needed)
-            continue;
-        /* --solid/--fluid are already in the case (coupler_record_init) */
-        const char *cmd = mps_case_string(c.cs, k == FLUID ? "fluid_solver" : "solid_solver");
-        snprintf(p->child.command, sizeof p->child.command, "%s", cmd);
-        if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint,
-                                               p->key_path[0] ? p->key_path : NULL, &err)))
-            goto end;
-        p->child.name = p->name;
-    }
-    /* one solver at a time, so the only message that can come unasked is an
-     * ERROR; the solid first, so the model its HELLO names is in the case
-     * file before the fluid reads it (coupler_record_hello) */
-    for (int q = NPEERS - 1; q >= 0; q--)
-        if (c.p[q].needed &&
-            ((st = handshake(&c, q, resolved, &err)) || (st = await_ready(&c, q, &err))))
-            goto end;
-    if ((st = open_probes(&c, &err)))
-        goto end;
-    if (!c.quiet)
-        fprintf(stderr, "coupler: %s%s%s, output in %s\n", c.p[FLUID].needed ? "fluid" : "",
-                c.p[FLUID].needed && c.p[SOLID].needed ? " + " : "",
-                c.p[SOLID].needed ? "solid" : "", c.out);
-    if ((st = run_loop(&c, &err)))
-        goto end;
-    st = stop_all(&c, &err);
-end:
-    if (st) {
-        fprintf(stderr, "\ncoupler: %s: %s\n", mps_status_name(st), err.msg);
-        abort_all(&c, err.msg);
-    } else {
-        for (int k = 0; k < NPEERS; k++)
-            launch_reap(&c.p[k].child, 10.0);
-    }
-    if (c.guard) {
-        guard_stop(c.guard);
-        char who[512];
-        guard_describe(c.guard, who, sizeof who);
-        if (who[0])
-            fprintf(stderr, "coupler: refused %ld unauthenticated connection%s: %s\n",
-                    guard_refused(c.guard), guard_refused(c.guard) == 1 ? "" : "s", who);
-    }
-    if (c.cs && c.out) {
-        write_summary(&c, st, &err);
-        write_scene(&c);
-        long lost = (long)bye_number(&c.p[FLUID], "lost_particles", 0);
-        if (lost > 0) /* a result, not progress: --quiet keeps it */
-            fprintf(stderr, "coupler: %ld fluid particle%s left over the open tank walls "
-                            "(removed; lost_particles in summary.json)\n",
-                    lost, lost == 1 ? "" : "s");
-    }
+    if (!(st = start_run(&c, &err)) && !(st = run_loop(&c, &err)))
+        st = stop_all(&c, &err);
+    st = finish_run(&c, st, &err);
     cleanup(&c);
     return mps_status_exit_code(st);
 }

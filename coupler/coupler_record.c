@@ -40,7 +40,7 @@ enum mps_status coupler_record_write(const struct coupler_record *r, const struc
         if (r->hello[k][0])
             fprintf(f, "# %s\n", r->hello[k]);
     int bad = ferror(f);
-    fclose(f);
+    bad |= fclose(f) != 0; /* the stream's buffer is only complete after it */
     free(prov);
     enum mps_status st = bad ? mps_err_set(err, MPS_ENOMEM, "%s: out of memory", r->path)
                              : mps_case_write_resolved(c, r->path, buf, err);

@@ -222,23 +222,36 @@ static void sleep_ms(int ms)
     nanosleep(&ts, NULL);
 }
 
-void launch_reap(struct child *c, double grace_s)
+#define REAP_TICK_MS 50
+#define REAP_KILL_TICKS 40 /* SIGTERM to SIGKILL: 2 s */
+
+void launch_reap_all(struct child *const *kids, const double *grace_s, int n)
 {
-    if (c->pid <= 0)
-        return;
-    for (int k = 0; k < (int)(grace_s * 20) && !launch_poll(c); k++)
-        sleep_ms(50);
-    if (!launch_poll(c)) {
-        kill(c->pid, SIGTERM);
-        for (int k = 0; k < 40 && !launch_poll(c); k++)
-            sleep_ms(50);
-    }
-    if (!launch_poll(c)) {
-        kill(c->pid, SIGKILL);
-        int status;
-        if (waitpid(c->pid, &status, 0) == c->pid) {
-            c->exited = 1;
-            c->status = status;
+    long termed[8] = {0}; /* tick + 1 at which child k got SIGTERM */
+    if (n > 8)
+        n = 8;
+    for (long tick = 0;; tick++) {
+        int running = 0;
+        for (int k = 0; k < n; k++) {
+            struct child *c = kids[k];
+            if (c->pid <= 0 || launch_poll(c))
+                continue;
+            if (!termed[k] && tick >= (long)(grace_s[k] * (1000 / REAP_TICK_MS))) {
+                kill(c->pid, SIGTERM);
+                termed[k] = tick + 1;
+            } else if (termed[k] && tick + 1 - termed[k] >= REAP_KILL_TICKS) {
+                kill(c->pid, SIGKILL);
+                int status;
+                if (waitpid(c->pid, &status, 0) == c->pid) {
+                    c->exited = 1;
+                    c->status = status;
+                }
+                continue;
+            }
+            running++;
         }
+        if (!running)
+            return;
+        sleep_ms(REAP_TICK_MS);
     }
 }

@@ -43,7 +43,9 @@ int launch_poll(struct child *c);
 /* "exited with status 3", "was killed by signal 11 (Segmentation fault)". */
 void launch_describe(const struct child *c, char *buf, size_t len);
 
-/* Waits up to grace_s for the child to exit, then SIGTERM, then SIGKILL. */
-void launch_reap(struct child *c, double grace_s);
+/* Waits for n children on one clock: child k gets SIGTERM grace_s[k] after
+ * the call if it is still running, SIGKILL 2 s after that. Returns once all
+ * have exited (at most max(grace_s) + 2 s). */
+void launch_reap_all(struct child *const *kids, const double *grace_s, int n);
 
 #endif

@@ -16,10 +16,28 @@
 #include "mps_mem.h"
 #include "mps_omp.h"
 
-enum method { M_PCG_JACOBI, M_PCG_IC0, M_CHOLMOD, M_CHOLMOD_REUSE, M_PCG_SIC0, M_PCG_DEFL };
+struct fluid_linsolve;
 
-static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "cholmod_reuse",
-                                           "pcg_sic0", "pcg_defl"};
+/* A method is a row of this table (the methods[] below): the solve (PCG or
+ * CHOLMOD), its preconditioner for PCG, what it starts at creation, and the
+ * options only some methods take. Nothing else in this file asks which
+ * method it is. */
+struct method_ops {
+    const char *name;
+    /* at creation, after the common fields (NULL: nothing to start) */
+    enum mps_status (*start)(struct fluid_linsolve *s, struct mps_err *err);
+    enum mps_status (*solve)(struct fluid_linsolve *s, const struct fluid_csr *A, const double *b,
+                             double *x, struct fluid_linsolve_stats *st, struct mps_err *err);
+    int iterative;       /* starts from x (warm start), trusts the caller's structure */
+    /* PCG: preconditioner set-up (NULL: Jacobi's, part of every PCG) and
+     * application z = M^-1 r returning r.z */
+    enum mps_status (*precond_setup)(struct fluid_linsolve *s, const struct fluid_csr *A,
+                                     struct mps_err *err);
+    double (*precond_apply)(struct fluid_linsolve *s, int n, const double *r, double *z);
+    int ic0_storage;     /* needs the IC(0) factor's arrays */
+    double drop;         /* default drop threshold theta; < 0: set_drop is ignored */
+    int reuse_ordering;  /* CHOLMOD: keep the fill-reducing ordering while it serves */
+};
 
 /* "auto" = pcg_defl since 2026-11-22: with the fluid's aggregates (cells of
  * 4 spacings) its iterations stay at 11-12 per step from 6k to 80k
@@ -41,7 +59,7 @@ static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "
  * ahead when the cores are shared (the usual case for a coupled run here),
  * and 3-4x fewer iterations, which keeps a margin under fluid.ppe_max_iter
  * on harder matrices. */
-#define AUTO_METHOD M_PCG_DEFL
+#define AUTO_METHOD "pcg_defl"
 
 #define METHOD_LIST "pcg_jacobi, pcg_ic0, pcg_sic0, pcg_defl, cholmod, cholmod_reuse, auto"
 
@@ -65,7 +83,7 @@ static const char *const method_names[] = {"pcg_jacobi", "pcg_ic0", "cholmod", "
 #define PAD 8
 
 struct fluid_linsolve {
-    enum method method;
+    const struct method_ops *ops;
     double rtol;
     int max_iter;
     int nthreads;        /* resolved: > 0 */
@@ -103,6 +121,39 @@ struct fluid_linsolve {
     int skip;            /* calls left before it is tried again */
 };
 
+static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, const double *b,
+                           double *x, struct fluid_linsolve_stats *st, struct mps_err *err);
+static enum mps_status direct(struct fluid_linsolve *s, const struct fluid_csr *A,
+                              const double *b, double *x, struct fluid_linsolve_stats *st,
+                              struct mps_err *err);
+static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_csr *A,
+                                 struct mps_err *err);
+static double ic0_apply(struct fluid_linsolve *s, int n, const double *r, double *z);
+static double k_jacobi(struct fluid_linsolve *s, int n, const double *r, double *z);
+static enum mps_status start_defl(struct fluid_linsolve *s, struct mps_err *err);
+static enum mps_status start_cholmod(struct fluid_linsolve *s, struct mps_err *err);
+
+/* The six methods. pcg_ic0 and pcg_sic0 share the IC(0) factor, its storage
+ * and its application; they differ only in the matrix factorised (sic0
+ * drops weak couplings first). pcg_defl is Jacobi PCG in the deflated space
+ * (the deflation works through s->defl, made by its start). */
+static const struct method_ops methods[] = {
+    {"pcg_jacobi", NULL, pcg, 1, NULL, k_jacobi, 0, -1.0, 0},
+    {"pcg_ic0", NULL, pcg, 1, ic0_setup, ic0_apply, 1, -1.0, 0},
+    {"pcg_sic0", NULL, pcg, 1, ic0_setup, ic0_apply, 1, SIC0_DEFAULT_DROP, 0},
+    {"pcg_defl", start_defl, pcg, 1, NULL, k_jacobi, 0, -1.0, 0},
+    {"cholmod", start_cholmod, direct, 0, NULL, NULL, 0, -1.0, 0},
+    {"cholmod_reuse", start_cholmod, direct, 0, NULL, NULL, 0, -1.0, 1},
+};
+
+static const struct method_ops *find_method(const char *name)
+{
+    for (size_t i = 0; i < sizeof methods / sizeof *methods; i++)
+        if (!strcmp(name, methods[i].name))
+            return &methods[i];
+    return NULL;
+}
+
 /* ---- CHOLMOD error capture: the handler has no user pointer, so the last
  * message goes into a thread-local buffer that the caller copies into err. */
 static _Thread_local char cholmod_msg[256];
@@ -137,7 +188,7 @@ static enum mps_status cholmod_fail(struct fluid_linsolve *s, const char *call,
     enum mps_status code = st == CHOLMOD_OUT_OF_MEMORY ? MPS_ENOMEM
                          : st == CHOLMOD_NOT_POSDEF  ? MPS_ESOLVE
                                                      : MPS_ELIB;
-    return mps_err_set(err, code, "%s: %s failed: %s%s%s", method_names[s->method], call,
+    return mps_err_set(err, code, "%s: %s failed: %s%s%s", s->ops->name, call,
                        cholmod_status_text(st), cholmod_msg[0] ? ": " : "", cholmod_msg);
 }
 
@@ -147,14 +198,7 @@ const char *fluid_linsolve_methods(void) { return METHOD_LIST; }
 
 const char *fluid_linsolve_method(const struct fluid_linsolve *s)
 {
-    return s ? method_names[s->method] : "(none)";
-}
-
-/* pcg_ic0 and pcg_sic0 share the factor, its storage and its application;
- * they differ only in the matrix factorised. */
-static inline int uses_ic0(const struct fluid_linsolve *s)
-{
-    return s->method == M_PCG_IC0 || s->method == M_PCG_SIC0;
+    return s ? s->ops->name : "(none)";
 }
 
 static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struct mps_err *err)
@@ -169,7 +213,7 @@ static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struc
     s->q = mps_realloc_or_flag(s->q, c, sizeof *s->q, &fail);
     s->dinv = mps_realloc_or_flag(s->dinv, c, sizeof *s->dinv, &fail);
     s->diag = mps_realloc_or_flag(s->diag, c, sizeof *s->diag, &fail);
-    if (uses_ic0(s)) {
+    if (s->ops->ic0_storage) {
         s->lptr = mps_realloc_or_flag(s->lptr, c + 1, sizeof *s->lptr, &fail);
         s->mark = mps_realloc_or_flag(s->mark, c, sizeof *s->mark, &fail);
         s->linv = mps_realloc_or_flag(s->linv, c, sizeof *s->linv, &fail);
@@ -177,7 +221,7 @@ static enum mps_status reserve_vectors(struct fluid_linsolve *s, size_t n, struc
     }
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate work vectors for %zu rows",
-                           method_names[s->method], n);
+                           s->ops->name, n);
     s->cap_n = c;
     return MPS_OK;
 }
@@ -187,23 +231,14 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
                                       struct mps_err *err)
 {
     *out = NULL;
-    enum method m;
     if (!method)
         return mps_err_set(err, MPS_EINPUT, "linear solver method not given: expected one of %s",
                            METHOD_LIST);
-    if (!strcmp(method, "auto")) {
-        m = AUTO_METHOD;
-    } else {
-        int found = -1;
-        for (int i = 0; i < (int)(sizeof method_names / sizeof *method_names); i++)
-            if (!strcmp(method, method_names[i]))
-                found = i;
-        if (found < 0)
-            return mps_err_set(err, MPS_EINPUT,
-                               "unknown linear solver method \"%s\": expected one of %s", method,
-                               METHOD_LIST);
-        m = (enum method)found;
-    }
+    const struct method_ops *m = find_method(strcmp(method, "auto") ? method : AUTO_METHOD);
+    if (!m)
+        return mps_err_set(err, MPS_EINPUT,
+                           "unknown linear solver method \"%s\": expected one of %s", method,
+                           METHOD_LIST);
     if (!(rtol > 0.0 && rtol < 1.0))
         return mps_err_set(err, MPS_EINPUT, "linear solver rtol = %g: must be in (0, 1)", rtol);
     if (max_iter < 1)
@@ -217,11 +252,11 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
     struct fluid_linsolve *s = calloc(1, sizeof *s);
     if (!s)
         return mps_err_set(err, MPS_ENOMEM, "cannot allocate the linear solver");
-    s->method = m;
+    s->ops = m;
     s->rtol = rtol;
     s->max_iter = max_iter;
     s->perm_n = -1;
-    s->drop2 = m == M_PCG_SIC0 ? SIC0_DEFAULT_DROP * SIC0_DEFAULT_DROP : 0.0;
+    s->drop2 = m->drop > 0.0 ? m->drop * m->drop : 0.0;
     s->nthreads = nthreads > 0 ? nthreads : omp_get_max_threads();
     if (s->nthreads < 1)
         s->nthreads = 1;
@@ -230,25 +265,31 @@ enum mps_status fluid_linsolve_create(struct fluid_linsolve **out, const char *m
         free(s);
         return mps_err_set(err, MPS_ENOMEM, "cannot allocate the linear solver");
     }
-    if (m == M_PCG_DEFL) {
-        enum mps_status st = fluid_defl_create(&s->defl, s->nthreads, PAR_MIN_ROWS, err);
-        if (st) {
-            fluid_linsolve_destroy(&s);
-            return st;
-        }
-    }
-    if (m == M_CHOLMOD || m == M_CHOLMOD_REUSE) {
-        cholmod_msg[0] = '\0';
-        if (!cholmod_start(&s->cm)) {
-            fluid_linsolve_destroy(&s);
-            return mps_err_set(err, MPS_ELIB, "%s: cholmod_start failed: %s", method,
-                               cholmod_msg);
-        }
-        s->cm_started = 1;
-        s->cm.print = 0;   /* errors come back through err, not stderr */
-        s->cm.error_handler = cholmod_error_capture;
+    enum mps_status st = m->start ? m->start(s, err) : MPS_OK;
+    if (st) {
+        fluid_linsolve_destroy(&s);
+        return st;
     }
     *out = s;
+    return MPS_OK;
+}
+
+/* pcg_defl's start: the coarse space */
+static enum mps_status start_defl(struct fluid_linsolve *s, struct mps_err *err)
+{
+    return fluid_defl_create(&s->defl, s->nthreads, PAR_MIN_ROWS, err);
+}
+
+/* cholmod's and cholmod_reuse's start */
+static enum mps_status start_cholmod(struct fluid_linsolve *s, struct mps_err *err)
+{
+    cholmod_msg[0] = '\0';
+    if (!cholmod_start(&s->cm))
+        return mps_err_set(err, MPS_ELIB, "%s: cholmod_start failed: %s", s->ops->name,
+                           cholmod_msg);
+    s->cm_started = 1;
+    s->cm.print = 0;   /* errors come back through err, not stderr */
+    s->cm.error_handler = cholmod_error_capture;
     return MPS_OK;
 }
 
@@ -287,8 +328,8 @@ enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
      * diagonal: a much worse preconditioner than Jacobi. */
     if (!(theta >= 0.0 && theta < 1.0))
         return mps_err_set(err, MPS_EINPUT, "%s: drop threshold theta = %g: must be in [0, 1)",
-                           method_names[s->method], theta);
-    if (s->method == M_PCG_SIC0)
+                           s->ops->name, theta);
+    if (s->ops->drop >= 0.0)
         s->drop2 = theta * theta;
     return MPS_OK;
 }
@@ -362,7 +403,7 @@ static enum mps_status describe_bad_row(const struct fluid_linsolve *s, const st
                                         int i, const double *b, const double *x,
                                         struct mps_err *err)
 {
-    const char *mn = method_names[s->method];
+    const char *mn = s->ops->name;
     int lo = A->rowptr[i], hi = A->rowptr[i + 1];
     if (hi < lo || lo < 0)
         return mps_err_set(err, MPS_EINPUT, "%s: row %d: rowptr %d..%d is not increasing", mn,
@@ -405,7 +446,7 @@ static enum mps_status check_input(const struct fluid_linsolve *s, const struct 
                                    const double *b, const double *x, int scan_rows,
                                    struct mps_err *err)
 {
-    const char *mn = method_names[s->method];
+    const char *mn = s->ops->name;
     if (A->n < 0)
         return mps_err_set(err, MPS_EINPUT, "%s: matrix size n = %d: must be >= 0", mn, A->n);
     if (A->n > 0 && (!A->rowptr || !A->col || !A->val || !b))
@@ -757,7 +798,7 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
         s->lval = mps_realloc_or_flag(s->lval, c, sizeof *s->lval, &fail);
         if (fail)
             return mps_err_set(err, MPS_ENOMEM, "%s: cannot allocate the IC(0) factor "
-                                                "(%zu entries)", method_names[s->method], lnz);
+                                                "(%zu entries)", s->ops->name, lnz);
         s->cap_lnz = c;
     }
     s->lval[lptr[n]] = 0.0;
@@ -770,7 +811,7 @@ static enum mps_status ic0_setup(struct fluid_linsolve *s, const struct fluid_cs
             return mps_err_set(err, MPS_ESOLVE,
                                "%s: incomplete Cholesky breaks down at row %d even with "
                                "the diagonal scaled by 1 + %g: matrix is not positive definite",
-                               method_names[s->method], row, shift);
+                               s->ops->name, row, shift);
         shift = shift > 0.0 ? 10.0 * shift : 1e-3;
     }
     return MPS_OK;
@@ -808,7 +849,7 @@ static double ic0_apply(struct fluid_linsolve *s, int n, const double *r, double
 
 static double precond(struct fluid_linsolve *s, int n, const double *r, double *z)
 {
-    return uses_ic0(s) ? ic0_apply(s, n, r, z) : k_jacobi(s, n, r, z);
+    return s->ops->precond_apply(s, n, r, z);
 }
 
 /* (Re)starts CG from the residual s->r of x: with deflation first moves x
@@ -832,13 +873,14 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
                            double *x, struct fluid_linsolve_stats *st, struct mps_err *err)
 {
     int n = A->n;
-    const char *mn = method_names[s->method];
+    const char *mn = s->ops->name;
     enum mps_status rc = reserve_vectors(s, (size_t)n, err);
     if (rc)
         return rc;
 
     double *r = s->r, *z = s->z, *p = s->p, *q = s->q;
-    const double *dinv = s->method == M_PCG_JACOBI || s->defl ? s->dinv : NULL;
+    /* Jacobi's z = dinv r is fused into the update (k_update) */
+    const double *dinv = s->ops->precond_apply == k_jacobi ? s->dinv : NULL;
     double t0 = omp_get_wtime(), rb[2];
     k_residual(s, s->nthreads, A, b, x, r, rb);
     if (!isfinite(rb[0]) || !isfinite(rb[1])) {
@@ -847,7 +889,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         enum mps_status bad = check_input(s, A, b, x, 1, err);
         return bad ? bad
                    : mps_err_set(err, MPS_ESOLVE, "%s: initial residual is not finite",
-                                 method_names[s->method]);
+                                 s->ops->name);
     }
     double bnorm = sqrt(rb[1]);
     if (bnorm == 0.0) {   /* b = 0: x = 0 exactly, no iteration */
@@ -872,7 +914,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
         s->diag[i] = k;
         s->dinv[i] = 1.0 / A->val[k];
     }
-    if (uses_ic0(s) && (rc = ic0_setup(s, A, err)))
+    if (s->ops->precond_setup && (rc = s->ops->precond_setup(s, A, err)))
         return rc;
     if (s->defl && (rc = fluid_defl_setup(s->defl, A, err)))
         return rc;
@@ -921,7 +963,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
                 return rc;
             continue;
         }
-        double rz_new = dinv ? upd[1] : ic0_apply(s, n, r, z);
+        double rz_new = dinv ? upd[1] : precond(s, n, r, z);
         double beta = rz_new / rz;
         rz = rz_new;
         if (!s->defl)
@@ -992,7 +1034,7 @@ static enum mps_status analyse(struct fluid_linsolve *s, cholmod_sparse *As,
 {
     cholmod_common *cm = &s->cm;
     double nnz = (double)A->rowptr[A->n];
-    int reuse = s->method == M_CHOLMOD_REUSE;
+    int reuse = s->ops->reuse_ordering;
     cholmod_free_factor(&s->L, cm);
     int try_old = reuse && s->perm_n == A->n;
     if (try_old && s->skip > 0) {
@@ -1058,7 +1100,7 @@ static enum mps_status direct(struct fluid_linsolve *s, const struct fluid_csr *
         return rc;
 
     double t0 = omp_get_wtime();
-    int reuse = s->method == M_CHOLMOD_REUSE;
+    int reuse = s->ops->reuse_ordering;
     if (!(reuse && same_pattern(s, A))) {   /* else the symbolic factor is still valid */
         if ((rc = analyse(s, &As, A, err)))
             return rc;
@@ -1073,7 +1115,7 @@ static enum mps_status direct(struct fluid_linsolve *s, const struct fluid_csr *
             rc = mps_err_set(err, MPS_ESOLVE,
                              "%s: cholmod_factorize: matrix not positive definite (pivot %zu of "
                              "%d, in the fill-reducing ordering, is not positive)",
-                             method_names[s->method], (size_t)s->L->minor + 1, n);
+                             s->ops->name, (size_t)s->L->minor + 1, n);
         else
             rc = cholmod_fail(s, "cholmod_factorize", err);
         cholmod_free_factor(&s->L, cm);
@@ -1128,10 +1170,10 @@ enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct flui
     memset(st, 0, sizeof *st);
     if (!s || !A || (A->n > 0 && !x))
         return mps_err_set(err, MPS_EINPUT, "fluid_linsolve_solve: NULL solver, matrix or x");
-    int iterative = s->method == M_PCG_JACOBI || uses_ic0(s) || s->method == M_PCG_DEFL;
+    int iterative = s->ops->iterative;
     enum mps_status rc =
         check_input(s, A, b, iterative ? x : NULL, !(iterative && s->trusted), err);
     if (rc || A->n == 0)
         return rc;
-    return iterative ? pcg(s, A, b, x, st, err) : direct(s, A, b, x, st, err);
+    return s->ops->solve(s, A, b, x, st, err);
 }

@@ -705,9 +705,8 @@ static enum mps_status decode(struct proto_msg *m, const struct proto_frame *fr,
         if (nul)
             return mps_err_set(err, MPS_EPROTO, "%s: text frame has a NUL byte at offset %td",
                                tn, nul - tdata);
-        long at = utf8_invalid_at(tdata, tlen);
-        if (at >= 0)
-            return mps_err_set(err, MPS_EPROTO, "%s: text is not valid UTF-8 at byte %ld", tn, at);
+        /* UTF-8 is checked with the rest by check_msg below, as for a
+         * message about to be sent */
         total += tlen + 1;
     }
 

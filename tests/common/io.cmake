@@ -9,6 +9,9 @@ target_link_libraries(test_h5 PRIVATE ${HDF5_C_LIBRARIES})
 mps_add_test(test_probes_json_cli SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_probes_json_cli.c
   LABELS unit TIMEOUT 30)
 mps_add_test(test_nbr SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_nbr.c LABELS unit TIMEOUT 30)
+# its AVX-512 comparisons alone: SKIPPED where the CPU has no AVX-512
+add_test(NAME test_nbr_avx512 COMMAND test_nbr avx512 WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(test_nbr_avx512 PROPERTIES TIMEOUT 30 LABELS unit SKIP_RETURN_CODE 77)
 
 # --version of every program names the tree's current git revision.
 add_test(NAME version_git_rev

@@ -372,9 +372,53 @@ static void test_round_trip(void)
     CHECK(mps_case_count(r, "fluid.blocks") == 4);
     CHECK_NEAR(mps_case_double(r, "fluid.blocks.3.x1"), 8, 0);
     CHECK(mps_case_has(r, "solid.odd") && mps_case_has(r, "solid.none") == 0);
-    CHECK(strcmp(mps_case_where(r, "gravity.x"), "default") != 0); /* now in the file */
+    /* Each key keeps where the user gave it (the file's line, --set, the
+     * default), so a solver that finds a problem in the copy names the
+     * user's file: fluid.rho is line 8 of good_yaml, solid.anything line 19. */
+    char want[300];
+    snprintf(want, sizeof want, "%s:8", path);
+    CHECK(strcmp(mps_case_where(r, "fluid.rho"), want) == 0);
+    CHECK(strcmp(mps_case_where(r, "fluid.blocks.3.x0"), "--set fluid.blocks.3.x0=7") == 0);
+    CHECK(strcmp(mps_case_where(r, "gravity.x"), "default") == 0);
+    /* a --set holding a line break cannot be one comment line: the copy's line */
+    CHECK(strncmp(mps_case_where(r, "description"), out, strlen(out)) == 0);
+    mps_err_clear(&err);
+    CHECK(mps_case_fail(r, &err, "fluid.rho", "too dense") == MPS_EINPUT);
+    snprintf(want, sizeof want, "%s:8: fluid.rho = 998.2: too dense", path);
+    CHECK(strcmp(err.msg, want) == 0);
+    /* a program that does not ignore solid.* names the user's line too */
+    struct mps_case *strict = (struct mps_case *)1;
+    CHECK(mps_case_load(&strict, out, NULL, 0, tables, 2, NULL, &err) == MPS_EINPUT);
+    snprintf(want, sizeof want, "%s:19: solid.anything = goes: unknown key", path);
+    CHECK(strict == NULL && strncmp(err.msg, want, strlen(want)) == 0);
+    if (strncmp(err.msg, want, strlen(want)) != 0)
+        fprintf(stderr, "  got:  %s\n  want: %s\n", err.msg, want);
     mps_case_destroy(&c);
     mps_case_destroy(&r);
+    /* a value edited in the copy is the copy's: its line is named */
+    FILE *f = fopen(out, "r+");
+    char text[8192];
+    size_t n = f ? fread(text, 1, sizeof text - 1, f) : 0;
+    text[n] = '\0';
+    char *rho = strstr(text, "rho: 998.2\n");
+    CHECK(f && rho);
+    if (f && rho) {
+        memcpy(rho, "rho: 998.3", 10);
+        rewind(f);
+        fputs(text, f);
+    }
+    CHECK(f && fclose(f) == 0);
+    r = load(out, NULL, 0, &err);
+    CHECK(r && strncmp(mps_case_where(r, "fluid.rho"), out, strlen(out)) == 0);
+    snprintf(want, sizeof want, "%s:9", path); /* fluid.nsteps: unchanged */
+    CHECK(r && strcmp(mps_case_where(r, "fluid.nsteps"), want) == 0);
+    mps_case_destroy(&r);
+    /* origin lines count only in a resolved file (its first line says so) */
+    const char *plain = write_tmp("dp: 0.01\nend_time: 1\n#@ dp\tspoof.yml:1\n");
+    struct mps_case *p = load(plain, NULL, 0, &err);
+    snprintf(want, sizeof want, "%s:1", plain);
+    CHECK(p && strcmp(mps_case_where(p, "dp"), want) == 0);
+    mps_case_destroy(&p);
 }
 
 /* Programmer errors abort: run each in a child and expect SIGABRT. */

@@ -10,6 +10,7 @@
 #include "../test_util.h"
 #include "mps_cli.h"
 #include "mps_json.h"
+#include "mps_json_read.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
@@ -153,6 +154,52 @@ static enum mps_status parse(struct mps_cli *cli, struct mps_cli_extra *ex, int 
     return mps_cli_parse(cli, argc, argv, ex, nex, "usage: prog CASE.yml --out DIR", err);
 }
 
+/* The coupler reads the solvers' summaries (BYE) with mps_json_top_number:
+ * only a top-level member counts, not the same key nested in an object or an
+ * array or quoted in a string (what a strstr reading took for the member). */
+static void test_json_read(void)
+{
+    double v = -1.0;
+    const char *bye = "{\"program\": \"solid\", \"note\": \"\\\"compute_seconds\\\": 9\", "
+                      "\"phases\": {\"compute_seconds\": 7, \"x\": [1, {\"a\": \"]\"}]}, "
+                      "\"list\": [\"compute_seconds\", 8],\n \"compute_seconds\" : -2.5e-1, "
+                      "\"lost\": null}";
+    CHECK(mps_json_top_number(bye, "compute_seconds", &v) == 1);
+    CHECK_NEAR(v, -0.25, 0.0);
+    CHECK(mps_json_top_number(bye, "lost", &v) == 0);      /* null is no number */
+    CHECK(mps_json_top_number(bye, "program", &v) == 0);   /* nor a string */
+    CHECK(mps_json_top_number(bye, "a", &v) == 0);         /* nested only */
+    CHECK(mps_json_top_number(bye, "compute", &v) == 0);   /* a prefix is not the key */
+    CHECK(mps_json_top_number("{}", "x", &v) == 0);
+    CHECK(mps_json_top_number(" {\"x\":3}", "x", &v) == 1 && v == 3.0);
+    /* not JSON objects, or cut short before the member */
+    CHECK(mps_json_top_number("", "x", &v) == -1);
+    CHECK(mps_json_top_number("[1]", "x", &v) == -1);
+    CHECK(mps_json_top_number("{\"y\": [1, 2}, \"x\": 1}", "x", &v) == -1);
+    CHECK(mps_json_top_number("{\"y\": \"open, \"x\": 1", "x", &v) == -1);
+    CHECK(mps_json_top_number("{\"x\": 12abc}", "x", &v) == -1);
+    CHECK(mps_json_top_number("{\"y\" 1, \"x\": 1}", "x", &v) == -1);
+    /* what the writer writes, the reader reads back */
+    char path[300];
+    snprintf(path, sizeof path, "%s/read.json", dir);
+    FILE *f = fopen(path, "w");
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    struct mps_json j;
+    mps_json_begin(&j, f);
+    mps_json_object(&j, "inner");
+    mps_json_num(&j, "lost_particles", 5);
+    mps_json_close(&j);
+    mps_json_str(&j, "text", "\"lost_particles\": 6");
+    mps_json_int(&j, "lost_particles", 12);
+    mps_json_end(&j);
+    CHECK(fclose(f) == 0);
+    char *text = slurp(path);
+    CHECK(text && mps_json_top_number(text, "lost_particles", &v) == 1 && v == 12.0);
+    free(text);
+}
+
 static void test_cli(void)
 {
     struct mps_cli cli;
@@ -275,6 +322,7 @@ int main(void)
     }
     test_probes();
     test_json();
+    test_json_read();
     test_cli();
     test_mkdir();
     test_timer_progress();

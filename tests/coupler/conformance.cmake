@@ -18,7 +18,8 @@ add_test(NAME conformance_solid_python
 add_test(NAME conformance_toy_solid
          COMMAND ${CONFORMANCE} --solid "${CONFORMANCE_TOY}"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-foreach(case "step;result\\.echo" "abort;abort\\.exit" "silent;malformed\\.bad_magic\\.error")
+foreach(case "step;result\\.echo" "abort;abort\\.exit" "silent;malformed\\.bad_magic\\.error"
+             "role;hello\\.text")
   list(GET case 0 bug)
   list(GET case 1 pattern)
   add_test(NAME conformance_catches_bug_${bug}
@@ -30,4 +31,5 @@ endforeach()
 set_tests_properties(conformance_solid_mps conformance_solid_tlsph conformance_solid_python
                      conformance_toy_solid conformance_catches_bug_step
                      conformance_catches_bug_abort conformance_catches_bug_silent
+                     conformance_catches_bug_role
                      PROPERTIES TIMEOUT 60 LABELS integration ENVIRONMENT OMP_NUM_THREADS=1)

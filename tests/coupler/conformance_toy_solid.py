@@ -7,6 +7,7 @@ breaks one rule, so ctest can check that the suite catches it:
   --bug step     RESULT echoes step + 1
   --bug abort    ignores ABORT and waits for the next message
   --bug silent   dies on a malformed message without sending ERROR
+  --bug role     says role=fluid in its HELLO
 
 usage: conformance_toy_solid.py [--bug NAME] --connect ENDPOINT
 """
@@ -100,7 +101,8 @@ def converse(sock):
 def main():
     ctx = zmq.Context()
     sock = mp.connect(ctx, args[args.index('--connect') + 1])
-    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=toy pid={os.getpid()}'))
+    role = 'fluid' if BUG == 'role' else 'solid'
+    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role={role} model=toy pid={os.getpid()}'))
     try:
         code = converse(sock)
     except (Fail, mp.ProtocolError, TimeoutError) as e:

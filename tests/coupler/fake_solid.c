@@ -10,11 +10,16 @@
  *   fake_solid [--amplitude A] [--frequency F] [--fail-at T] [--version V]
  *              --connect ENDPOINT
  * --fail-at T makes it crash (abort) at time T, for the coupler's failure
- * tests; --hang-at T makes it stop answering. */
+ * tests; --hang-at T makes it stop answering at time T, --hang-in hello
+ * before it connects, --hang-in ready after CONFIG (before READY). With
+ * --hang-mark FILE it writes the wall-clock second (CLOCK_REALTIME, as
+ * Python's time.time()) at which it stops answering into FILE, so a test
+ * measures the coupler's deadline from there. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "mps_case.h"
@@ -31,6 +36,8 @@
 
 struct fake {
     double amp, freq, fail_at, hang_at;
+    const char *hang_in;   /* "hello", "ready" or NULL */
+    const char *hang_mark; /* file for the time the hang began, or NULL */
     double dp;
     size_t n;
     int *id;
@@ -60,10 +67,28 @@ static void place(struct fake *s, double t)
     }
 }
 
+/* Stops answering for good, after writing the time into s->hang_mark. */
+static void hang(const struct fake *s)
+{
+    if (s->hang_mark) {
+        struct timespec now;
+        clock_gettime(CLOCK_REALTIME, &now);
+        FILE *f = fopen(s->hang_mark, "w");
+        if (f) {
+            fprintf(f, "%.6f\n", (double)now.tv_sec + 1e-9 * (double)now.tv_nsec);
+            fclose(f);
+        }
+    }
+    for (;;)
+        pause();
+}
+
 static enum mps_status configure(void *self, const char *case_path, const char *out,
                                  const char *prefix, struct mps_err *err)
 {
     struct fake *s = self;
+    if (s->hang_in && !strcmp(s->hang_in, "ready"))
+        hang(s);
     struct mps_case *c = NULL;
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
@@ -139,8 +164,7 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
     if (s->fail_at >= 0.0 && in->time >= s->fail_at)
         abort(); /* a crash, as a buggy solver would */
     if (s->hang_at >= 0.0 && in->time >= s->hang_at)
-        for (;;)
-            pause();
+        hang(s);
     s->force[0] = s->force[1] = 0.0;
     struct solid_loads loads = {0};
     if (in->payload == PROTO_LOADS) {
@@ -203,6 +227,10 @@ int main(int argc, char **argv)
             s.fail_at = atof(argv[++i]);
         else if (!strcmp(argv[i], "--hang-at"))
             s.hang_at = atof(argv[++i]);
+        else if (!strcmp(argv[i], "--hang-in"))
+            s.hang_in = argv[++i];
+        else if (!strcmp(argv[i], "--hang-mark"))
+            s.hang_mark = argv[++i];
     }
     const char *endpoint = NULL;
     int hello_ms;
@@ -211,6 +239,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "fake_solid: %s\n", err.msg[0] ? err.msg : "needs --connect ENDPOINT");
         return 2;
     }
+    if (s.hang_in && !strcmp(s.hang_in, "hello"))
+        hang(&s);
     static const struct proto_solver_ops ops = {"solid", "fake", configure, ready, advance, finish};
     enum mps_status st = proto_solver_run(endpoint, &ops, &s, hello_ms, &stop_flag, &stats, &err);
     if (st)

@@ -1,13 +1,26 @@
 #!/usr/bin/python3
 """Checks a coarse elastic-gate run (dp = 2.5 mm, the gate 2 particles thick,
-to 0.2 s): the water pushes the gate's free end downstream and up.
-At dp = 1 mm (docs/elastic_gate.md) both solids open it to 3.7-4.1 cm at
-0.11-0.12 s; the coarse gate is 2 particles thick (0.75 of the bending
-stiffness of t^3/12, so it opens wider) and its water front is blunter, so the
-band is wide: largest opening 2.2-5.8 cm (-40% / +40%), reached after 0.08 s
-(the gate cannot open faster than the water accelerates), below the gate's
-length; tip_dy >= -2 mm (the end cannot go down into the floor) and > 0 at
-the largest opening (it swings up on its arc)."""
+to 0.2 s): the water column pushes the gate's free end open, downstream and
+up, to a first peak, after which the gate closes as the column drains.
+
+The band is the primary opening: the largest tip_dx up to 0.15 s must lie in
+3.35-3.85 cm, reached at 0.09-0.125 s. Physics: at dp = 1 mm (5 particles
+thick, docs/elastic_gate.md) the solids peak at 3.66-4.14 cm at 0.111-0.123 s
+(MPS plane strain and quadratic TLSPH, the two consistent discretisations,
+3.66 and 3.81 cm: 4% apart); the opening is driven by the column, and both
+coarse solids, two different discretisations of the same 2-particle gate,
+peak at 3.58-3.59 cm at 0.099-0.105 s (measured 2026-12-02, the same to 0.01 cm
+with 1 and 2 threads and MPS_SIMD=sse2). The band is that value +-7%: the spread of the
+consistent fine solids plus a margin. Then, at 0.15 s, the gate is
+closing (tip_dx below its peak), the end never goes down into the floor
+(tip_dy >= -2 mm) and it swings up on its arc (tip_dy > 0 at the peak).
+
+Before: the largest opening over the whole run within 2.2-5.8 cm, which a
+gate 40% too stiff or too soft passed. What happens after 0.15 s is not
+checked: the coarse MPS gate is kicked open again at 0.17-0.19 s by a load
+spike (solid_fx 45 -> 440 N/m) that neither the TLSPH gate nor the 1 mm runs
+show, and not with 1 thread (a chaotic splash; reported, left to the fluid's
+owners)."""
 import csv, os, sys
 
 with open(os.path.join(sys.argv[1], 'probes.csv')) as f:
@@ -15,8 +28,17 @@ with open(os.path.join(sys.argv[1], 'probes.csv')) as f:
 t = [float(r['time']) for r in rows]
 dx = [float(r['tip_dx']) for r in rows]
 dy = [float(r['tip_dy']) for r in rows]
-k = max(range(len(dx)), key=lambda i: dx[i])
-ok = 0.022 <= dx[k] <= 0.058 and t[k] >= 0.08 and min(dy) >= -0.002 and dy[k] > 0
-print(f"tip dx max {100 * dx[k]:.2f} cm at {t[k]:.3f} s (dy {100 * dy[k]:.2f} cm), final "
-      f"{100 * dx[-1]:.2f} cm, dy min {1000 * min(dy):.2f} mm:", 'ok' if ok else 'FAIL')
-sys.exit(0 if ok else 1)
+early = [i for i in range(len(t)) if t[i] <= 0.15 + 1e-9]
+k = max(early, key=lambda i: dx[i])
+at15 = min(range(len(t)), key=lambda i: abs(t[i] - 0.15))
+checks = [
+    (0.0335 <= dx[k] <= 0.0385, f"peak opening {100 * dx[k]:.2f} cm (band 3.35-3.85 cm)"),
+    (0.09 <= t[k] <= 0.125, f"at {t[k]:.3f} s (band 0.09-0.125 s)"),
+    (dx[at15] < dx[k], f"closing at 0.15 s: {100 * dx[at15]:.2f} cm"),
+    (min(dy) >= -0.002, f"tip_dy min {1000 * min(dy):.2f} mm (>= -2 mm)"),
+    (dy[k] > 0, f"tip_dy at the peak {100 * dy[k]:.2f} cm (> 0)"),
+]
+for ok, what in checks:
+    print(('ok   ' if ok else 'FAIL ') + what)
+print(f"(after 0.15 s, not checked: tip_dx max {100 * max(dx):.2f} cm, final {100 * dx[-1]:.2f} cm)")
+sys.exit(0 if all(ok for ok, _ in checks) else 1)

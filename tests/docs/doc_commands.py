@@ -106,6 +106,9 @@ SHORT = [
      'fuzzers (MPS_FUZZ=1 and clang)'),
     ('docs/solid_models.md', r'^\s*bench/solid_cantilever\.py --bin build/bin/solid_solver.*\\\n.*$',
      'true', 'the cantilever table of each model: minutes'),
+    ('docs/testing.md', r'^nice -n 10 /usr/bin/python3 tests/mutation/run\.py .*$',
+     '/usr/bin/python3 tests/mutation/run.py --check',
+     'the mutation check (hours: a build and tests per fault): only that every fault applies'),
 ]
 
 

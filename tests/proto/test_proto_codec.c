@@ -248,6 +248,14 @@ static void test_header_rejections(void)
     FRESH();
     put64(&c, 48, (uint64_t)1 << 60); /* count * 16 would wrap 64 bits */
     EXPECT_REJECT(&c, "exceeds 2147483647", "count too large");
+    /* the limit itself (PROTOCOL.md 5: ids are i32): one over is refused by
+     * the count check, the limit passes it and fails on the frames' length */
+    FRESH();
+    put64(&c, 48, PROTO_MAX_COUNT + 1);
+    EXPECT_REJECT(&c, "count = 2147483648 exceeds 2147483647", "count one over the limit");
+    FRESH();
+    put64(&c, 48, PROTO_MAX_COUNT);
+    EXPECT_REJECT(&c, "frame 1 (id): 28 bytes, expected 8589934588", "count at the limit");
     FRESH();
     put32(&c, 60, 70000);
     EXPECT_REJECT(&c, "nprobes = 70000 exceeds", "nprobes too large");

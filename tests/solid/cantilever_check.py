@@ -57,6 +57,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("probes")
     ap.add_argument("--freq-tol", type=float, help="max |f error|, percent")
+    ap.add_argument("--freq-range", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="f error within [LO, HI], percent")
     ap.add_argument("--defl-max", type=float, help="max deflection discrepancy, percent")
     ap.add_argument("--defl-min", type=float, help="min deflection discrepancy, percent")
     ap.add_argument("--min-periods", type=float, help="min number of periods simulated")
@@ -67,6 +69,9 @@ def main():
     if a.freq_tol is not None and abs(r["f_err_pct"]) > a.freq_tol:
         bad.append(f"f = {r['f']:.4f} Hz is {r['f_err_pct']:+.2f}% off {F_REF:.4f} Hz "
                    f"(tolerance {a.freq_tol}%)")
+    if a.freq_range and not a.freq_range[0] <= r["f_err_pct"] <= a.freq_range[1]:
+        bad.append(f"f = {r['f']:.4f} Hz is {r['f_err_pct']:+.2f}% off {F_REF:.4f} Hz "
+                   f"(allowed {a.freq_range[0]:+g}% to {a.freq_range[1]:+g}%)")
     if a.defl_max is not None and r["disc_pct"] > a.defl_max:
         bad.append(f"max deflection {r['dmax_cm']:.2f} cm: discrepancy {r['disc_pct']:.2f}% "
                    f"above {a.defl_max}%")

@@ -1,7 +1,7 @@
 # Solid solver tests: unit (operators, model, stability, conservation),
 # integration (the program: outputs, bad input) and validation (cantilever).
 set(SOLID_TEST_DIR ${CMAKE_CURRENT_LIST_DIR})
-foreach(t operators model stability conservation damping)
+foreach(t operators model stability conservation damping stress)
   mps_add_test(test_solid_${t} SOURCES ${SOLID_TEST_DIR}/test_solid_${t}.c LIBS solidcore
     LABELS unit TIMEOUT 60)
   target_include_directories(test_solid_${t} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
@@ -45,12 +45,18 @@ solid_bad(set_E "--set solid\\.bodies\\.0\\.E=-1: solid\\.bodies\\.0\\.E = -1: m
 solid_bad(model "--model nosuch: unknown solid model \\(known: mps"
   ${SOLID_CASES}/block.yml --model nosuch)
 
-# Cantilever beam (paper 5.1) at b/dp = 5 over two periods (1.7 s). Bands: f within
-# 2.5% of 1.277 Hz (measured -2.1%: the 5 particle rows have a second moment
-# sum dp y^2 = 0.96 b^3/12, -2% in f) and a maximum deflection within the
-# paper's 5.07% of 47.09 cm at this resolution (measured 4.0% above).
+# Cantilever beam (paper 5.1) at b/dp = 5 over two periods (1.7 s). The 5
+# particle rows have a second moment sum dp y^2 = 0.96 b^3/12, which predicts
+# f -2.0% from 1.277 Hz (f ~ sqrt(EI)) and a deflection discrepancy of -4.2%
+# from 47.09 cm (1/EI; the paper allows 5.07%). Measured -2.08% and -4.02%,
+# the same with 1 and 2 threads (the MPS solid's step is bit-identical for
+# any thread count, test_solid_model). Bands: 0.5 points around the predicted
+# f, 0.7 around the predicted deflection (the lattice's other discrete
+# errors: the surface bonds' weights, the clamp). Before: f within 2.5%,
+# deflection within 5.07%, which a plane-strain lambda in place of the
+# plane-stress one passed by 0.7 points.
 add_test(NAME solid_cantilever_b5
-  COMMAND sh -c "rm -rf \"$0\" && \"$1\" cases/cantilever_beam/case.yml --out \"$0\" --quiet && /usr/bin/python3 tests/solid/cantilever_check.py \"$0/probes.csv\" --freq-tol 2.5 --defl-max 5.07 --defl-min -5.07 --min-periods 2"
+  COMMAND sh -c "rm -rf \"$0\" && \"$1\" cases/cantilever_beam/case.yml --out \"$0\" --quiet && /usr/bin/python3 tests/solid/cantilever_check.py \"$0/probes.csv\" --freq-range -2.5 -1.5 --defl-max -3.5 --defl-min -4.9 --min-periods 2"
     ${SOLID_OUT}/cantilever_b5 ${SOLID_BIN}
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(solid_cantilever_b5 PROPERTIES TIMEOUT 60 LABELS validation)
