@@ -16,5 +16,33 @@ const struct mps_key_spec coupler_case_keys[] = {
     {"coupling.pin_cpus", MPS_KEY_ENUM, "auto", 0, 0, 0, "auto|off", "",
      "auto: the coupler and the solvers' main threads share one CPU (cheaper messages), "
      "OpenMP workers take the others; off: the OS places them"},
+    /* implicit coupling: docs/coupling.md, "Implicit coupling" */
+    {"coupling.scheme", MPS_KEY_ENUM, "explicit", 0, 0, 0, "explicit|implicit", "",
+     "explicit: the paper's weak coupling, one fluid and one solid solve per step; implicit: "
+     "each step repeated from its start until the interface converges"},
+    {"coupling.implicit.acceleration", MPS_KEY_ENUM, "aitken", 0, 0, 0,
+     "aitken|iqn_ils|constant", "",
+     "how the next iterate of the interface is chosen (coupler/coupling_accel.h)"},
+    {"coupling.implicit.relaxation", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "initial relaxation factor of each step (aitken, iqn_ils without columns); the factor "
+     "of constant"},
+    {"coupling.implicit.tolerance", MPS_KEY_DOUBLE, "1e-3", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+     "converged when the rms change of the interface positions is at most this times their "
+     "rms displacement from the start, plus abs_tolerance"},
+    {"coupling.implicit.abs_tolerance", MPS_KEY_DOUBLE, "1e-7", 0, 0, MPS_KEY_NO_HI, NULL, "m",
+     "absolute part of the convergence test (the interface at rest has no displacement)"},
+    {"coupling.implicit.max_iterations", MPS_KEY_INT, "30", 1, 1000, 0, NULL, "",
+     "iterations (fluid and solid solves) per step at most"},
+    {"coupling.implicit.on_max", MPS_KEY_ENUM, "accept", 0, 0, 0, "accept|error", "",
+     "at max_iterations: accept the last iterate (warned and counted in summary.json) or stop "
+     "with an error"},
+    {"coupling.implicit.reuse", MPS_KEY_INT, "8", 0, 100, 0, NULL, "",
+     "iqn_ils: past steps whose columns are kept"},
+    {"coupling.implicit.predictor", MPS_KEY_ENUM, "linear", 0, 0, 0, "linear|none", "",
+     "first iterate of a step: the state extrapolated from the last two steps, or the state "
+     "at the step's start (the explicit step)"},
+    {"coupling.implicit.log", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
+     "write OUT/iterations.csv: every iteration's interface change, displacement and "
+     "relaxation factor"},
     {NULL, 0, NULL, 0, 0, 0, NULL, NULL, NULL},
 };

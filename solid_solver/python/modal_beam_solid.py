@@ -16,6 +16,11 @@ Snapshots (at startup and after an ADVANCE with SNAPSHOT) are CSV files
 OUT/PREFIX_NNNNNN.csv. Failures are reported to the coupler as ERROR
 (PROTOCOL.md 8). tests/coupler/conformance.py checks it against the protocol.
 
+Implicit coupling (PROTOCOL.md 6): it declares caps=rollback; with rollback=on
+in CONFIG it keeps (q, q') at the start of every step and returns to them when
+the coupler repeats the step (a repeated snapshot overwrites its file, which is
+named by the step).
+
 usage: modal_beam_solid.py [--courant C] --connect ENDPOINT
 """
 import json, math, os, sys, time
@@ -93,7 +98,7 @@ class Fail(Exception):
         super().__init__(f'{status}: {message}')
 
 
-CONFIG_KEYS = ('case', 'out', 'prefix', 'timeout_ms')
+CONFIG_KEYS = ('case', 'out', 'prefix', 'timeout_ms', 'rollback')
 
 
 def snapshot(conf, step, t, beam):
@@ -130,6 +135,10 @@ def converse(sock, courant, t_wall):
     except (OSError, KeyError, TypeError, ValueError, IndexError, yaml.YAMLError) as e:
         raise Fail('input', f"case {conf['case']}: {type(e).__name__}: {e}") from e
     timeout = int(conf.get('timeout_ms', '1800000'))
+    if conf.get('rollback', 'off') not in ('on', 'off'):
+        raise Fail('input', f"CONFIG rollback={conf['rollback']}: must be on or off")
+    roll = mp.Rollback(conf.get('rollback') == 'on')
+    kept = (beam.q, beam.qd)   # the state a repeated step starts from
     step = 0
     snapshot(conf, 0, 0.0, beam)
 
@@ -154,6 +163,11 @@ def converse(sock, courant, t_wall):
         if m.type != mp.Type.ADVANCE:
             raise Fail('protocol', f'expected ADVANCE, STOP or ABORT, got {mp.Type(m.type).name}')
         c0 = time.time()
+        if roll.check(m) == 'new':
+            kept = (beam.q, beam.qd)
+        else:
+            beam.q, beam.qd = kept
+            step -= 1  # counts steps, not repeats
         beam.force = 0.0
         if m.payload == mp.Payload.LOADS and m.count:
             idx = m.id.astype(np.int64)
@@ -180,7 +194,8 @@ def main():
     courant = float(args[args.index('--courant') + 1]) if '--courant' in args else 0.5
     ctx = zmq.Context()
     sock = mp.connect(ctx, endpoint)
-    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
+    mp.send(sock, mp.Message(mp.Type.HELLO,
+                             text=f'role=solid model=modal_beam pid={os.getpid()} caps=rollback'))
     try:
         code = converse(sock, courant, time.time())
     except (Fail, mp.ProtocolError, TimeoutError) as e:

@@ -6,7 +6,10 @@
  *   fake_solid [--amplitude A] [--frequency F] [--fail-at T] [--version V]
  *              --connect ENDPOINT
  * --fail-at T makes it crash (abort) at time T, for the coupler's failure
- * tests; --hang-at T makes it stop answering. */
+ * tests; --hang-at T makes it stop answering. It can repeat a step (implicit
+ * coupling: its state is a function of time, so there is nothing to keep);
+ * --no-rollback makes it a solver that cannot (no caps=rollback in HELLO),
+ * which the coupler must refuse when implicit coupling is asked. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -135,6 +138,14 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
     return MPS_OK;
 }
 
+/* The path is a function of time: a repeated step needs nothing restored. */
+static enum mps_status save(void *self, struct mps_err *err)
+{
+    (void)self;
+    (void)err;
+    return MPS_OK;
+}
+
 static struct proto_solver_stats stats;
 
 static char *finish(void *self, enum mps_status st, const struct mps_err *err)
@@ -153,6 +164,10 @@ static volatile int stop_flag = 0;
 int main(int argc, char **argv)
 {
     struct fake s = {.amp = 0.0, .freq = 1.0, .fail_at = -1.0, .hang_at = -1.0};
+    int rollback = 1;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--no-rollback"))
+            rollback = 0;
     for (int i = 1; i + 1 < argc; i++) {
         if (!strcmp(argv[i], "--amplitude"))
             s.amp = atof(argv[++i]);
@@ -170,8 +185,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "fake_solid: %s\n", err.msg[0] ? err.msg : "needs --connect ENDPOINT");
         return 2;
     }
-    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready, advance, finish};
-    enum mps_status st = proto_solver_run(endpoint, &ops, &s, hello_ms, &stop_flag, &stats, &err);
+    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready,
+                                                advance, finish,  save,      save};
+    static const struct proto_solver_ops ops_fixed = {"solid", "fake", configure,
+                                                      ready,   advance, finish, NULL, NULL};
+    enum mps_status st = proto_solver_run(endpoint, rollback ? &ops : &ops_fixed, &s, hello_ms,
+                                          &stop_flag, &stats, &err);
     if (st)
         fprintf(stderr, "fake_solid: %s: %s\n", mps_status_name(st), err.msg);
     free(s.id);

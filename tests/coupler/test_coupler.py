@@ -196,10 +196,56 @@ def t_wrong_version():
     solver = os.path.join(ROOT, 'tests', 'coupler', 'bad_version_solver.py')
     rc, err = run([SCENE, '--out', out, '--quiet', '--solid', f'/usr/bin/python3 {solver} {report}'])
     check(rc != 0, f'coupler refuses the solver (exit {rc})')
-    check('protocol version 2 received, this build speaks version 1' in err,
+    check('protocol version 1 received, this build speaks version 2' in err,
           'coupler says which versions')
     told = open(report).read() if os.path.exists(report) else ''
-    check(told.startswith('REJECT') and 'version 2' in told, f'solver was told: {told.strip()}')
+    check(told.startswith('REJECT') and 'version 1' in told, f'solver was told: {told.strip()}')
+
+
+def t_no_rollback():
+    """Implicit coupling repeats steps: a solid that does not declare
+    caps=rollback in HELLO is refused at the handshake (exit 2, the reason on
+    stderr and in its REJECT), nothing is stepped; the same solver runs
+    explicit."""
+    for solid in ('fake_solid --no-rollback',
+                  f'/usr/bin/python3 {ROOT}/tests/coupler/conformance_toy_solid.py'):
+        out = tempfile.mkdtemp(prefix='cpl_noroll_')
+        rc, err = run([SCENE, '--out', out, '--quiet', '--solid', solid,
+                       '--set', 'coupling.scheme=implicit', '--set', 'end_time=0.01'])
+        check(rc == 2, f'{solid}: implicit refused with exit 2 (got {rc})')
+        check('caps=rollback' in err and 'solid' in err,
+              f'{solid}: the coupler says why: {err.strip().splitlines()[-1] if err.strip() else ""}')
+        s = json.load(open(os.path.join(out, 'summary.json')))
+        check(s['coupling_steps'] == 0 and s['failed_solver'] == 'solid',
+              f'{solid}: no step taken, the solid named ({s["coupling_steps"]}, {s["failed_solver"]})')
+    out = tempfile.mkdtemp(prefix='cpl_noroll_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid --no-rollback',
+                   '--set', 'end_time=0.01'])
+    check(rc == 0, f'the same solid runs explicit (exit {rc}) {err.strip()[-200:]}')
+
+
+def t_implicit_fake():
+    """Implicit coupling with the fake solid (a rigid plate on a prescribed
+    path: its state does not depend on the loads, so the fixed point is its
+    path and every step converges): the run ends, every step took at least one
+    and at most a few iterations, the summary counts them, and the force the
+    fake solid received is the explicit run's within the load noise."""
+    res = {}
+    for scheme in ('explicit', 'implicit'):
+        out = tempfile.mkdtemp(prefix=f'cpl_{scheme}_')
+        rc, err = run([SCENE, '--out', out, '--quiet', '--solid',
+                       'fake_solid --amplitude 0.002 --frequency 2', '--set', f'coupling.scheme={scheme}',
+                       '--set', 'end_time=0.2'])
+        check(rc == 0, f'{scheme}: exit {rc} {err.strip()[-300:]}')
+        res[scheme] = (json.load(open(os.path.join(out, 'summary.json'))), probes(out))
+    s = res['implicit'][0]
+    it = s.get('iterations', {})
+    check(it.get('scheme') == 'implicit' and it.get('steps') == s['coupling_steps'],
+          f'summary counts the implicit steps: {it}')
+    check(1 <= it.get('max', 0) <= 6 and it.get('mean', 0) >= 1.0 and it.get('limit_hits') == 0,
+          f'iterations per step: mean {it.get("mean")}, max {it.get("max")}, limit hits {it.get("limit_hits")}')
+    e = res['explicit'][0]['iterations']
+    check(e.get('mean') == 1.0 and e.get('max') == 1, f'explicit: one iteration per step ({e})')
 
 
 def cpus_allowed(pid, tid=None):

@@ -1,0 +1,10 @@
+# Implicit coupling (issue 18): the solvers' rollback, the acceleration
+# schemes, and short runs of the hard cases (docs/hard_cases.md).
+
+# The fluid repeats a step bit for bit from its checkpoint (two threads: the
+# OpenMP reductions must not make a repeat differ).
+add_test(NAME fluid_rollback
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/fluid_rollback.py ${CMAKE_BINARY_DIR}/bin
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_rollback PROPERTIES TIMEOUT 120 LABELS integration
+                     ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive")
