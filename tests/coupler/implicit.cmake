@@ -8,3 +8,8 @@ add_test(NAME fluid_rollback
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(fluid_rollback PROPERTIES TIMEOUT 120 LABELS integration
                      ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive")
+
+# Aitken and IQN-ILS on a linear model problem with a known fixed point.
+mps_add_test(test_coupling_accel SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_coupling_accel.c
+             LIBS couplercore LABELS unit TIMEOUT 30)
+target_include_directories(test_coupling_accel PRIVATE ${CMAKE_SOURCE_DIR}/tests)
