@@ -345,11 +345,9 @@ static enum mps_status await_ready(struct coupler *c, int k, struct mps_err *err
         }
         c->state = m; /* keep: it is the fluid's first boundary */
         if (c->implicit)
-            return coupling_iter_init(&c->iter, &m, mps_case_double(c->cs,
-                                      "coupling.implicit.tolerance"),
+            return coupling_iter_init(&c->iter, &m,
+                                      mps_case_double(c->cs, "coupling.implicit.tolerance"),
                                       mps_case_double(c->cs, "coupling.implicit.abs_tolerance"),
-                                      strcmp(mps_case_string(c->cs, "coupling.implicit.predictor"),
-                                             "linear") == 0,
                                       err);
         return MPS_OK;
     }
@@ -503,7 +501,7 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
     c->accel_seconds += mps_wall_seconds() - a0;
     if (st)
         return st;
-    int k = 0, converged = 0;
+    int k = 0, converged = 0, rerun = 0;
     for (;;) {
         adv->iteration = k;
         adv->payload = PROTO_STATE;
@@ -530,6 +528,8 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
         if (!st && !converged && k < c->max_iter)
             st = coupling_iter_relax(&c->iter, c->accel, &send, err);
         c->accel_seconds += mps_wall_seconds() - a0;
+        if (!st && !converged && k >= c->max_iter && !rerun && !c->on_max_error)
+            rerun = coupling_iter_best(&c->iter, &send); /* once more with the best */
         if (c->iter_log)
             fprintf(c->iter_log, "%ld,%.9g,%d,%.6e,%.6e,%.6g\n", c->step, c->time, k - 1,
                     c->iter.change, c->iter.displacement,
@@ -537,8 +537,10 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
         if (st)
             return mps_err_prefix(err, "step %ld at t = %.6g s, iteration %d: ", c->step,
                                   c->time, k - 1);
-        if (converged || k >= c->max_iter)
+        if (converged || (k >= c->max_iter && rerun != 1))
             break;
+        if (rerun == 1)
+            rerun = 2; /* the repeat of the best is sent now; accepted whatever it gives */
     }
     coupling_accel_end(c->accel);
     count_iterations(c, k);
@@ -928,7 +930,8 @@ int main(int argc, char **argv)
         (st = coupling_accel_create(&c.accel,
                                     mps_case_string(c.cs, "coupling.implicit.acceleration"),
                                     mps_case_double(c.cs, "coupling.implicit.relaxation"),
-                                    (int)mps_case_int(c.cs, "coupling.implicit.reuse"), &err)))
+                                    (int)mps_case_int(c.cs, "coupling.implicit.reuse"),
+                                    mps_case_double(c.cs, "coupling.implicit.filter"), &err)))
         goto end;
     if ((st = mps_mkdir_p(c.out, &err)))
         goto end;

@@ -26,21 +26,21 @@ const struct mps_key_spec coupler_case_keys[] = {
     {"coupling.implicit.relaxation", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "initial relaxation factor of each step (aitken, iqn_ils without columns); the factor "
      "of constant"},
-    {"coupling.implicit.tolerance", MPS_KEY_DOUBLE, "1e-3", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+    {"coupling.implicit.tolerance", MPS_KEY_DOUBLE, "1e-2", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "converged when the rms change of the interface positions is at most this times their "
      "rms displacement from the start, plus abs_tolerance"},
     {"coupling.implicit.abs_tolerance", MPS_KEY_DOUBLE, "1e-7", 0, 0, MPS_KEY_NO_HI, NULL, "m",
      "absolute part of the convergence test (the interface at rest has no displacement)"},
-    {"coupling.implicit.max_iterations", MPS_KEY_INT, "30", 1, 1000, 0, NULL, "",
+    {"coupling.implicit.max_iterations", MPS_KEY_INT, "20", 1, 1000, 0, NULL, "",
      "iterations (fluid and solid solves) per step at most"},
     {"coupling.implicit.on_max", MPS_KEY_ENUM, "accept", 0, 0, 0, "accept|error", "",
      "at max_iterations: accept the last iterate (warned and counted in summary.json) or stop "
      "with an error"},
-    {"coupling.implicit.reuse", MPS_KEY_INT, "8", 0, 100, 0, NULL, "",
+    {"coupling.implicit.reuse", MPS_KEY_INT, "2", 0, 100, 0, NULL, "",
      "iqn_ils: past steps whose columns are kept"},
-    {"coupling.implicit.predictor", MPS_KEY_ENUM, "linear", 0, 0, 0, "linear|none", "",
-     "first iterate of a step: the state extrapolated from the last two steps, or the state "
-     "at the step's start (the explicit step)"},
+    {"coupling.implicit.filter", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
+     "iqn_ils: a column whose part orthogonal to the newer ones is shorter than this "
+     "fraction of it is dropped"},
     {"coupling.implicit.log", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
      "write OUT/iterations.csv: every iteration's interface change, displacement and "
      "relaxation factor"},

@@ -9,7 +9,8 @@
  *   constant   x~_(k+1) = x~_k + w r_k, w fixed;
  *   aitken     the same with Aitken's dynamic factor (Irons & Tuck 1969;
  *              Kuettler & Wall 2008): w_k = -w_(k-1) r_(k-1).(r_k - r_(k-1))
- *              / |r_k - r_(k-1)|^2, w_0 = the initial factor every step;
+ *              / |r_k - r_(k-1)|^2; w_0 is the last step's final factor when
+ *              that is in (0, 1], else the initial factor;
  *   iqn_ils    interface quasi-Newton with an inverse Jacobian from least
  *              squares (Degroote et al. 2009): with V the differences of
  *              successive residuals and W those of successive outputs (this
@@ -17,8 +18,8 @@
  *              |V c + r_k| and x~_(k+1) = x_k + W c; a step's first
  *              iteration with no columns relaxes with the initial factor.
  * Vectors are plain doubles of one length n per step (the coupler packs
- * positions and velocities of the interface particles). The module keeps no
- * pointer to the caller's arrays. */
+ * the positions of the interface particles, coupling_iter.h). The module
+ * keeps no pointer to the caller's arrays. */
 #ifndef COUPLING_ACCEL_H
 #define COUPLING_ACCEL_H
 
@@ -30,16 +31,20 @@ struct coupling_accel;
 
 /* name: "constant", "aitken" or "iqn_ils" (coupling_accel_names()); omega:
  * the initial (or constant) relaxation factor, in (0, 1]; reuse: iqn_ils
- * keeps the columns of this many past steps (0: only the current step's). */
+ * keeps the columns of this many past steps (0: only the current step's);
+ * filter: iqn_ils drops a column whose part orthogonal to the newer ones is
+ * shorter than this fraction of it, in [0, 1) (the QR2 filter of
+ * Haelterman et al. 2016). */
 enum mps_status coupling_accel_create(struct coupling_accel **out, const char *name,
-                                      double omega, int reuse, struct mps_err *err);
+                                      double omega, int reuse, double filter,
+                                      struct mps_err *err);
 void coupling_accel_destroy(struct coupling_accel **a);
 
 /* "constant, aitken, iqn_ils", for messages. */
 const char *coupling_accel_names(void);
 const char *coupling_accel_name(const struct coupling_accel *a);
 
-/* A coupling step starts: its vectors have n entries (past columns of
+/* A coupling step starts: its vectors have n > 0 entries (past columns of
  * another length are dropped). */
 enum mps_status coupling_accel_begin(struct coupling_accel *a, size_t n, struct mps_err *err);
 

@@ -6,30 +6,30 @@
 
 size_t coupling_iter_len(const struct coupling_iter *it)
 {
-    return 2 * MPS_DIM * it->n;
+    return MPS_DIM * it->n;
 }
 
 enum mps_status coupling_iter_init(struct coupling_iter *it, const struct proto_msg *ready,
-                                   double tol, double atol, int predictor, struct mps_err *err)
+                                   double tol, double atol, struct mps_err *err)
 {
     memset(it, 0, sizeof *it);
-    const size_t n = ready->count, m = n ? n : 1, len = 2 * MPS_DIM * m;
+    const size_t n = ready->count, m = n ? n : 1;
     it->tol = tol;
     it->atol = atol;
-    it->predictor = predictor;
     it->id = malloc(m * sizeof *it->id);
     it->surface = malloc(m);
     it->fixed = malloc(m);
     it->x0 = malloc(m * sizeof *it->x0);
-    it->x_last = malloc(m * sizeof *it->x_last);
-    it->v_last = malloc(m * sizeof *it->v_last);
+    it->x_start = malloc(m * sizeof *it->x_start);
+    it->x_prev = malloc(m * sizeof *it->x_prev);
     it->x_send = malloc(m * sizeof *it->x_send);
     it->v_send = malloc(m * sizeof *it->v_send);
-    it->in = malloc(len * sizeof *it->in);
-    it->out = malloc(len * sizeof *it->out);
-    it->next = malloc(len * sizeof *it->next);
-    if (!it->id || !it->surface || !it->fixed || !it->x0 || !it->x_last || !it->v_last ||
-        !it->x_send || !it->v_send || !it->in || !it->out || !it->next) {
+    it->in = malloc(m * sizeof *it->in * MPS_DIM);
+    it->out = malloc(m * sizeof *it->out * MPS_DIM);
+    it->next = malloc(m * sizeof *it->next * MPS_DIM);
+    it->best = malloc(m * sizeof *it->best * MPS_DIM);
+    if (!it->id || !it->surface || !it->fixed || !it->x0 || !it->x_start || !it->x_prev ||
+        !it->x_send || !it->v_send || !it->in || !it->out || !it->next || !it->best) {
         coupling_iter_free(it);
         return mps_err_set(err, MPS_ENOMEM, "implicit coupling: out of memory for %zu particles",
                            n);
@@ -50,13 +50,14 @@ void coupling_iter_free(struct coupling_iter *it)
     free(it->surface);
     free(it->fixed);
     free(it->x0);
-    free(it->x_last);
-    free(it->v_last);
+    free(it->x_start);
+    free(it->x_prev);
     free(it->x_send);
     free(it->v_send);
     free(it->in);
     free(it->out);
     free(it->next);
+    free(it->best);
     memset(it, 0, sizeof *it);
 }
 
@@ -80,25 +81,13 @@ static enum mps_status same_interface(const struct coupling_iter *it, const stru
     return MPS_OK;
 }
 
-static void pack(const struct coupling_iter *it, const double (*x)[MPS_DIM],
-                 const double (*v)[MPS_DIM], double *vec)
-{
-    const size_t nd = MPS_DIM * it->n;
-    for (size_t k = 0; k < it->n; k++)
-        for (int a = 0; a < MPS_DIM; a++) {
-            vec[MPS_DIM * k + a] = x[k][a];
-            vec[nd + MPS_DIM * k + a] = v[k][a] * it->dt;
-        }
-}
-
-/* vec into the arrays of send; fixed particles keep their given state. */
+/* Positions vec into send, with the step's mean velocity (header). */
 static void unpack(struct coupling_iter *it, const double *vec, struct proto_msg *send)
 {
-    const size_t nd = MPS_DIM * it->n;
     for (size_t k = 0; k < it->n; k++)
         for (int a = 0; a < MPS_DIM; a++) {
             it->x_send[k][a] = vec[MPS_DIM * k + a];
-            it->v_send[k][a] = vec[nd + MPS_DIM * k + a] / it->dt;
+            it->v_send[k][a] = (vec[MPS_DIM * k + a] - it->x_start[k][a]) / it->dt;
         }
     *send = proto_msg_make(PROTO_ADVANCE);
     send->payload = PROTO_STATE;
@@ -119,23 +108,21 @@ enum mps_status coupling_iter_start(struct coupling_iter *it, const struct proto
     if (!(dt > 0.0))
         return mps_err_set(err, MPS_EINPUT, "implicit coupling: step %g s", dt);
     it->dt = dt;
-    pack(it, now->x, now->v, it->in);
-    if (it->predictor && it->have_last && it->dt_last > 0.0) {
-        /* s_n + (s_n - s_(n-1)) dt_n / dt_(n-1), x and v alike */
-        const double f = dt / it->dt_last;
-        for (size_t k = 0; k < it->n; k++)
-            for (int a = 0; a < MPS_DIM; a++) {
-                if (it->fixed[k])
-                    continue;
-                size_t q = MPS_DIM * k + (size_t)a, qv = MPS_DIM * it->n + q;
-                it->in[q] += f * (now->x[k][a] - it->x_last[k][a]);
-                it->in[qv] += f * (now->v[k][a] - it->v_last[k][a]) * dt;
-            }
-    }
-    memcpy(it->x_last, now->x, it->n * sizeof *it->x_last);
-    memcpy(it->v_last, now->v, it->n * sizeof *it->v_last);
-    it->dt_last = dt;
-    it->have_last = 1;
+    memcpy(it->x_start, now->x, it->n * sizeof *it->x_start);
+    /* x_n + (x_n - x_(n-1)) dt_n / dt_(n-1); the first step x_0 + v_0 dt.
+     * Clamped particles stay put. */
+    const double f = it->dt_prev > 0.0 ? dt / it->dt_prev : 0.0;
+    for (size_t k = 0; k < it->n; k++)
+        for (int a = 0; a < MPS_DIM; a++) {
+            double step = it->fixed[k] ? 0.0
+                        : f > 0.0  ? f * (now->x[k][a] - it->x_prev[k][a])
+                                   : dt * now->v[k][a];
+            it->in[MPS_DIM * k + a] = now->x[k][a] + step;
+        }
+    memcpy(it->x_prev, now->x, it->n * sizeof *it->x_prev);
+    it->dt_prev = dt;
+    it->best_change = INFINITY;
+    it->best_k = it->last_k = -1;
     unpack(it, it->in, send);
     return MPS_OK;
 }
@@ -146,12 +133,12 @@ enum mps_status coupling_iter_result(struct coupling_iter *it, const struct prot
     enum mps_status st = same_interface(it, res, err);
     if (st)
         return st;
-    pack(it, res->x, res->v, it->out);
     double ch = 0.0, disp = 0.0;
     for (size_t k = 0; k < it->n; k++)
         for (int a = 0; a < MPS_DIM; a++) {
-            double d = it->out[MPS_DIM * k + a] - it->in[MPS_DIM * k + a];
-            double u = res->x[k][a] - it->x0[k][a];
+            size_t q = MPS_DIM * k + (size_t)a;
+            it->out[q] = res->x[k][a];
+            double d = it->out[q] - it->in[q], u = res->x[k][a] - it->x0[k][a];
             ch += d * d;
             disp += u * u;
         }
@@ -159,7 +146,22 @@ enum mps_status coupling_iter_result(struct coupling_iter *it, const struct prot
     it->change = sqrt(ch * inv);
     it->displacement = sqrt(disp * inv);
     *converged = it->change <= it->tol * it->displacement + it->atol;
+    it->last_k++;
+    if (it->change < it->best_change) {
+        it->best_change = it->change;
+        it->best_k = it->last_k;
+        memcpy(it->best, it->in, coupling_iter_len(it) * sizeof *it->best);
+    }
     return MPS_OK;
+}
+
+int coupling_iter_best(struct coupling_iter *it, struct proto_msg *send)
+{
+    if (it->best_k < 0 || it->best_k == it->last_k)
+        return 0;
+    memcpy(it->in, it->best, coupling_iter_len(it) * sizeof *it->in);
+    unpack(it, it->in, send);
+    return 1;
 }
 
 enum mps_status coupling_iter_relax(struct coupling_iter *it, struct coupling_accel *a,
@@ -169,13 +171,10 @@ enum mps_status coupling_iter_relax(struct coupling_iter *it, struct coupling_ac
     if (st)
         return st;
     /* clamped particles stay where the solid has them, whatever the scheme */
-    const size_t nd = MPS_DIM * it->n;
     for (size_t k = 0; k < it->n; k++)
         if (it->fixed[k])
-            for (int q = 0; q < MPS_DIM; q++) {
+            for (int q = 0; q < MPS_DIM; q++)
                 it->next[MPS_DIM * k + q] = it->out[MPS_DIM * k + q];
-                it->next[nd + MPS_DIM * k + q] = it->out[nd + MPS_DIM * k + q];
-            }
     double *t = it->in;
     it->in = it->next;
     it->next = t;

@@ -115,7 +115,7 @@ static int run(const char *scheme, double omega, int reuse, double tol, int max,
 {
     struct coupling_accel *a = NULL;
     struct mps_err err;
-    if (coupling_accel_create(&a, scheme, omega, reuse, &err)) {
+    if (coupling_accel_create(&a, scheme, omega, reuse, 0.1, &err)) {
         fprintf(stderr, "%s\n", err.msg);
         return -2;
     }
@@ -168,7 +168,7 @@ int main(void)
     struct mps_err err;
     int steps_reuse[3], steps_fresh[3];
     for (int pass = 0; pass < 2; pass++) {
-        CHECK(coupling_accel_create(&a, "iqn_ils", 0.5, pass == 0 ? 2 : 0, &err) == MPS_OK);
+        CHECK(coupling_accel_create(&a, "iqn_ils", 0.5, pass == 0 ? 2 : 0, 0.01, &err) == MPS_OK);
         memset(x, 0, sizeof x);
         for (int s = 0; s < 3; s++) {
             set_fixed_point(0.1 * (s + 1));
@@ -184,9 +184,10 @@ int main(void)
     CHECK(steps_fresh[1] > 2 * steps_reuse[1]);
 
     /* input errors */
-    CHECK(coupling_accel_create(&a, "newton", 0.5, 0, &err) == MPS_EINPUT && !a);
+    CHECK(coupling_accel_create(&a, "newton", 0.5, 0, 0.1, &err) == MPS_EINPUT && !a);
     CHECK(strstr(err.msg, "aitken") != NULL);
-    CHECK(coupling_accel_create(&a, "aitken", 0.0, 0, &err) == MPS_EINPUT && !a);
-    CHECK(coupling_accel_create(&a, "aitken", 1.5, 0, &err) == MPS_EINPUT && !a);
+    CHECK(coupling_accel_create(&a, "aitken", 0.0, 0, 0.1, &err) == MPS_EINPUT && !a);
+    CHECK(coupling_accel_create(&a, "aitken", 1.5, 0, 0.1, &err) == MPS_EINPUT && !a);
+    CHECK(coupling_accel_create(&a, "iqn_ils", 0.5, 0, 1.0, &err) == MPS_EINPUT && !a);
     return test_summary("test_coupling_accel");
 }
