@@ -91,7 +91,7 @@ struct coupler {
     long limit_hits;           /* steps accepted at max_iterations */
     long iter_hist[8];         /* steps that took 1, 2, 3-4, 5-8, 9-16, 17-32, 33-64, more */
     double accel_seconds;      /* in the coupler's own vector work */
-    double change_max;         /* largest accepted rms change / displacement (relative) */
+    double change_max;         /* largest converged rms change / step's displacement */
     long iter_probe_sum, iter_probe_steps; /* for the probe column */
     FILE *iter_log;            /* coupling.implicit.log: OUT/iterations.csv */
 };
@@ -531,8 +531,8 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
         if (!st && !converged && k >= c->max_iter && !rerun && !c->on_max_error)
             rerun = coupling_iter_best(&c->iter, &send); /* once more with the best */
         if (c->iter_log)
-            fprintf(c->iter_log, "%ld,%.9g,%d,%.6e,%.6e,%.6g\n", c->step, c->time, k - 1,
-                    c->iter.change, c->iter.displacement,
+            fprintf(c->iter_log, "%ld,%.9g,%d,%.6e,%.6e,%.6e,%.6g\n", c->step, c->time, k - 1,
+                    c->iter.change, c->iter.increment, c->iter.displacement,
                     converged || k >= c->max_iter ? 0.0 : coupling_accel_last(c->accel));
         if (st)
             return mps_err_prefix(err, "step %ld at t = %.6g s, iteration %d: ", c->step,
@@ -544,23 +544,23 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
     }
     coupling_accel_end(c->accel);
     count_iterations(c, k);
-    double rel = c->iter.displacement > 0.0 ? c->iter.change / c->iter.displacement : 0.0;
+    double rel = c->iter.increment > 0.0 ? c->iter.change / c->iter.increment : 0.0;
     if (!converged) {
         if (c->on_max_error)
             return mps_err_set(err, MPS_EDIVERGED,
                                "implicit coupling did not converge in %d iterations at step %ld, "
                                "t = %.6g s: rms change of the interface %.3g m against a "
-                               "displacement of %.3g m (coupling.implicit.tolerance %g, "
-                               "abs_tolerance %g m; coupling.implicit.on_max: error)",
-                               k, c->step, c->time, c->iter.change, c->iter.displacement,
+                               "displacement of %.3g m over the step (coupling.implicit.tolerance "
+                               "%g, abs_tolerance %g m/s; coupling.implicit.on_max: error)",
+                               k, c->step, c->time, c->iter.change, c->iter.increment,
                                c->iter.tol, c->iter.atol);
         if (c->limit_hits++ == 0 && !c->quiet)
             fprintf(stderr,
                     "\ncoupler: warning: step %ld at t = %.6g s not converged in %d iterations "
-                    "(rms change %.3g m, displacement %.3g m): accepted "
+                    "(rms change %.3g m, displacement over the step %.3g m): accepted "
                     "(coupling.implicit.on_max: accept); such steps are counted in "
                     "summary.json\n",
-                    c->step, c->time, k, c->iter.change, c->iter.displacement);
+                    c->step, c->time, k, c->iter.change, c->iter.increment);
     } else if (rel > c->change_max) {
         c->change_max = rel;
     }
@@ -993,7 +993,9 @@ int main(int argc, char **argv)
         }
         /* factor: the relaxation factor (constant, aitken) or the columns
          * (iqn_ils) that chose the next iterate; 0 on the step's last */
-        fputs("step,time,iteration,change_rms_m,displacement_rms_m,factor\n", c.iter_log);
+        fputs("step,time,iteration,change_rms_m,step_displacement_rms_m,displacement_rms_m,"
+              "factor\n",
+              c.iter_log);
     }
     if (!c.quiet)
         fprintf(stderr, "coupler: %s%s%s, output in %s\n", c.p[FLUID].needed ? "fluid" : "",

@@ -26,11 +26,13 @@ const struct mps_key_spec coupler_case_keys[] = {
     {"coupling.implicit.relaxation", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "initial relaxation factor of each step (aitken, iqn_ils without columns); the factor "
      "of constant"},
-    {"coupling.implicit.tolerance", MPS_KEY_DOUBLE, "1e-2", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+    {"coupling.implicit.tolerance", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "converged when the rms change of the interface positions is at most this times their "
-     "rms displacement from the start, plus abs_tolerance"},
-    {"coupling.implicit.abs_tolerance", MPS_KEY_DOUBLE, "1e-7", 0, 0, MPS_KEY_NO_HI, NULL, "m",
-     "absolute part of the convergence test (the interface at rest has no displacement)"},
+     "rms displacement over the step (the mean velocity the fluid saw is within this "
+     "fraction of the solid's), plus abs_tolerance times the step"},
+    {"coupling.implicit.abs_tolerance", MPS_KEY_DOUBLE, "1e-4", 0, 0, MPS_KEY_NO_HI, NULL, "m/s",
+     "absolute part of the convergence test, as a velocity (an interface at rest has no "
+     "displacement)"},
     {"coupling.implicit.max_iterations", MPS_KEY_INT, "20", 1, 1000, 0, NULL, "",
      "iterations (fluid and solid solves) per step at most"},
     {"coupling.implicit.on_max", MPS_KEY_ENUM, "accept", 0, 0, 0, "accept|error", "",

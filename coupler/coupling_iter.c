@@ -133,19 +133,22 @@ enum mps_status coupling_iter_result(struct coupling_iter *it, const struct prot
     enum mps_status st = same_interface(it, res, err);
     if (st)
         return st;
-    double ch = 0.0, disp = 0.0;
+    double ch = 0.0, disp = 0.0, inc = 0.0;
     for (size_t k = 0; k < it->n; k++)
         for (int a = 0; a < MPS_DIM; a++) {
             size_t q = MPS_DIM * k + (size_t)a;
             it->out[q] = res->x[k][a];
             double d = it->out[q] - it->in[q], u = res->x[k][a] - it->x0[k][a];
+            double s = res->x[k][a] - it->x_start[k][a];
             ch += d * d;
             disp += u * u;
+            inc += s * s;
         }
     double inv = it->n ? 1.0 / (double)it->n : 0.0;
     it->change = sqrt(ch * inv);
     it->displacement = sqrt(disp * inv);
-    *converged = it->change <= it->tol * it->displacement + it->atol;
+    it->increment = sqrt(inc * inv);
+    *converged = it->change <= it->tol * it->increment + it->atol * it->dt;
     it->last_k++;
     if (it->change < it->best_change) {
         it->best_change = it->change;

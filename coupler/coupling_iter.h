@@ -50,8 +50,9 @@ struct coupling_iter {
     double best_change;             /* its rms change (m); INFINITY: none yet */
     int best_k, last_k;             /* their iterations (0-based) */
     double (*x_send)[MPS_DIM], (*v_send)[MPS_DIM];
-    /* the last iteration's measure: rms|x_k - x~_k|, rms|x_k - x_0| (m) */
-    double change, displacement;
+    /* the last iteration's measures (m): rms|x_k - x~_k|, rms|x_k - x_0|,
+     * rms|x_k - x_start| */
+    double change, displacement, increment;
 };
 
 /* From the solid's READY (its STATE payload: ids, order, flags and reference

@@ -1,7 +1,12 @@
 /* A fake solid for coupling tests (no solid physics): the first body of the
  * case as a rigid lattice of particles moving on a prescribed path
  *   x(t) = x0 + A sin(2 pi f t),
- * that reports the total fluid force it receives as probes. It speaks the
+ * that reports the total fluid force it receives as probes, and tip_EI: the
+ * quasi-static tip deflection those loads would give a cantilever clamped at
+ * the top of the case's first clamp, times its E I (N m^2 per metre):
+ * sum_k f_x,k a_k^2 (3 L - a_k) / 6, a_k the particle's height above the
+ * clamp, L the free length (Euler-Bernoulli; docs/hard_cases.md, the stiff
+ * plate against the rigid limit). It speaks the
  * protocol through proto_solver like the real solids do.
  *   fake_solid [--amplitude A] [--frequency F] [--fail-at T] [--version V]
  *              --connect ENDPOINT
@@ -33,6 +38,8 @@ struct fake {
     double (*x0)[2], (*x)[2], (*v)[2];
     unsigned char *surface, *fixed;
     double force[2];
+    double tip_ei;             /* see the header */
+    double yc, len;            /* clamp top, free length (m) */
     double t;
 };
 
@@ -61,7 +68,13 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     s->dp = mps_case_double(c, "dp");
     double b[4] = {mps_case_double(c, "solid.bodies.0.x0"), mps_case_double(c, "solid.bodies.0.y0"),
                    mps_case_double(c, "solid.bodies.0.x1"), mps_case_double(c, "solid.bodies.0.y1")};
+    /* the clamp's top: the top of the highest row whose centres it covers */
+    double cy1 = mps_case_count(c, "solid.clamps") ? mps_case_double(c, "solid.clamps.0.y1") : b[1];
     mps_case_destroy(&c);
+    s->yc = b[1];
+    for (long j = 0; b[1] + (j + 0.5) * s->dp <= cy1; j++)
+        s->yc = b[1] + (j + 1.0) * s->dp;
+    s->len = b[3] - s->yc;
     long nx = (long)floor((b[2] - b[0]) / s->dp + 1e-6), ny = (long)floor((b[3] - b[1]) / s->dp + 1e-6);
     s->n = (size_t)(nx * ny);
     s->id = calloc(s->n, sizeof *s->id);
@@ -102,8 +115,8 @@ static void fill_state(struct fake *s, struct proto_msg *m)
 static enum mps_status ready(void *self, struct proto_msg *reply, struct mps_err *err)
 {
     fill_state(self, reply);
-    reply->nprobes = 3;
-    reply->text = "plate_fx,plate_fy,plate_dx";
+    reply->nprobes = 4;
+    reply->text = "plate_fx,plate_fy,plate_dx,tip_EI";
     (void)err;
     return MPS_OK;
 }
@@ -117,21 +130,27 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
     if (s->hang_at >= 0.0 && in->time >= s->hang_at)
         for (;;)
             pause();
-    s->force[0] = s->force[1] = 0.0;
+    s->force[0] = s->force[1] = s->tip_ei = 0.0;
     if (in->payload == PROTO_LOADS)
         for (size_t k = 0; k < in->count; k++) {
             s->force[0] += in->force[k][0];
             s->force[1] += in->force[k][1];
+            int i = in->id[k];
+            if (i >= 0 && (size_t)i < s->n) {
+                double a = fmin(fmax(s->x0[i][1] - s->yc, 0.0), s->len);
+                s->tip_ei += in->force[k][0] * a * a * (3.0 * s->len - a) / 6.0;
+            }
         }
     s->t = in->time + in->dt;
     place(s, s->t);
     fill_state(s, reply);
-    static double probes[3];
+    static double probes[4];
     probes[0] = s->force[0];
     probes[1] = s->force[1];
     probes[2] = s->x[0][0] - s->x0[0][0];
+    probes[3] = s->tip_ei;
     if (in->flags & PROTO_F_PROBES) {
-        reply->nprobes = 3;
+        reply->nprobes = 4;
         reply->probes = probes;
     }
     (void)err;
