@@ -3,13 +3,15 @@
  * interface only (solid_model.h), for any model: docs/hard_cases.md, the
  * elastic gate against Timoshenko beam theory.
  *
- *   solid_static_load CASE.yml --body NAME --water-level H [--model mps|tlsph]
- *       [--load-scale S] [--damping C] [--max-time T] [--set key=value]...
+ *   solid_static_load CASE.yml --body NAME --water-level H [--water-right H2]
+ *       [--model mps|tlsph] [--load-scale S] [--damping C] [--max-time T]
+ *       [--set key=value]...
  *
  * Every particle of the body's leftmost column below H gets the force
  * S rho_w g (H - y) dp (N/m, +x; rho_w = 1000, g = 9.81, y its initial
  * height), the pressure of still water of level H times the face it stands
- * for. Gravity on the solid is switched off (beam theory leaves out the
+ * for; with --water-right, the rightmost column below H2 gets
+ * -S rho_w g (H2 - y) dp (water on both sides). Gravity on the solid is switched off (beam theory leaves out the
  * body's weight). The body is brought to rest by a damping force -C m v on
  * every particle (C in 1/s; near twice the first bending frequency settles it
  * fastest), added to the loads each step, and stepped at the model's stable
@@ -39,7 +41,7 @@ static int fail(const char *msg)
 int main(int argc, char **argv)
 {
     const char *case_path = NULL, *body_name = NULL, *model = NULL;
-    double level = NAN, scale = 1.0, damping = 150.0, tmax = 2.0;
+    double level = NAN, right = -INFINITY, scale = 1.0, damping = 150.0, tmax = 2.0;
     const char *sets[MAX_SETS + 1];
     int nsets = 0;
     sets[nsets++] = "gravity.y=0";
@@ -49,6 +51,8 @@ int main(int argc, char **argv)
             body_name = argv[++i];
         else if (!strcmp(a, "--water-level") && v)
             level = atof(argv[++i]);
+        else if (!strcmp(a, "--water-right") && v)
+            right = atof(argv[++i]);
         else if (!strcmp(a, "--model") && v)
             model = argv[++i];
         else if (!strcmp(a, "--load-scale") && v)
@@ -63,8 +67,8 @@ int main(int argc, char **argv)
             case_path = a;
         else
             return fail("usage: solid_static_load CASE.yml --body NAME --water-level H "
-                        "[--model mps|tlsph] [--load-scale S] [--damping C] [--max-time T] "
-                        "[--set key=value]...");
+                        "[--water-right H2] [--model mps|tlsph] [--load-scale S] [--damping C] "
+                        "[--max-time T] [--set key=value]...");
     }
     if (!case_path || !body_name || !isfinite(level) || !(damping >= 0.0) || !(tmax > 0.0))
         return fail("needs CASE.yml, --body NAME and --water-level H (m); --damping >= 0, "
@@ -101,7 +105,7 @@ int main(int argc, char **argv)
     if (ops->interface(m, 1e30, &all, &err))
         goto done;
     const size_t n = all.n;
-    const double dp = sc->dp, x_face = sc->bodies[b].x0 + dp;
+    const double dp = sc->dp, x_face = sc->bodies[b].x0 + dp, x_back = sc->bodies[b].x1 - dp;
     double *hydro = calloc(n, sizeof *hydro), *mass = calloc(n, sizeof *mass);
     double (*force)[MPS_DIM] = calloc(n, sizeof *force);
     int *id = malloc(n * sizeof *id);
@@ -122,7 +126,9 @@ int main(int argc, char **argv)
         id[k] = all.id[k];
         mass[k] = (body >= 0 ? sc->bodies[body].rho : 0.0) * dp * dp;
         if (body == b && x[0] < x_face && x[1] < level)
-            hydro[k] = scale * RHO_W * G * (level - x[1]) * dp;
+            hydro[k] += scale * RHO_W * G * (level - x[1]) * dp;
+        if (body == b && x[0] > x_back && x[1] < right)
+            hydro[k] -= scale * RHO_W * G * (right - x[1]) * dp;
     }
     double t = 0.0, wall0 = mps_wall_seconds(), last = NAN, t_check = 0.01;
     long steps = 0;
