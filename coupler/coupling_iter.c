@@ -150,7 +150,7 @@ enum mps_status coupling_iter_result(struct coupling_iter *it, const struct prot
     it->increment = sqrt(inc * inv);
     *converged = it->change <= it->tol * it->increment + it->atol * it->dt;
     it->last_k++;
-    if (it->change < it->best_change) {
+    if (it->change <= it->best_change) { /* ties: the later, already the solvers' state */
         it->best_change = it->change;
         it->best_k = it->last_k;
         memcpy(it->best, it->in, coupling_iter_len(it) * sizeof *it->best);

@@ -9,10 +9,13 @@ add_test(NAME fluid_rollback
 set_tests_properties(fluid_rollback PROPERTIES TIMEOUT 120 LABELS integration
                      ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive")
 
-# Aitken and IQN-ILS on a linear model problem with a known fixed point.
-mps_add_test(test_coupling_accel SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_coupling_accel.c
-             LIBS couplercore LABELS unit TIMEOUT 30)
-target_include_directories(test_coupling_accel PRIVATE ${CMAKE_SOURCE_DIR}/tests)
+# Aitken and IQN-ILS on a linear model problem with a known fixed point; the
+# interface vector (what the fluid is sent, convergence, best iterate).
+foreach(t accel iter)
+  mps_add_test(test_coupling_${t} SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_coupling_${t}.c
+               LIBS couplercore LABELS unit TIMEOUT 30)
+  target_include_directories(test_coupling_${t} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
+endforeach()
 
 # The static deflection of a body under a hydrostatic load, any solid model
 # (bench/solid_static_load.c; docs/hard_cases.md, the gate against
