@@ -373,12 +373,14 @@ static enum mps_status exchange(struct coupler *c, int k, struct proto_msg *adv,
     if (adv->iteration > 0)
         p->repeat_seconds += mps_wall_seconds() - t0;
     p->exchanges++;
-    if (res->step != adv->step || res->time != adv->time + adv->dt) {
+    if (res->step != adv->step || res->iteration != adv->iteration ||
+        res->time != adv->time + adv->dt) {
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
         return mps_err_set(err, MPS_EPROTO,
-                           "%s RESULT is for step %lld at t = %.17g, expected step %lld at %.17g",
-                           p->name, (long long)res->step, res->time, (long long)adv->step,
-                           adv->time + adv->dt);
+                           "%s RESULT is for step %lld iteration %d at t = %.17g, expected step "
+                           "%lld iteration %d at %.17g",
+                           p->name, (long long)res->step, res->iteration, res->time,
+                           (long long)adv->step, adv->iteration, adv->time + adv->dt);
     }
     if (!(res->dt > 0.0)) {
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
@@ -746,7 +748,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
         mps_json_num(&j, "mean", c->step ? (double)c->iterations / c->step : 0.0);
         mps_json_int(&j, "max", c->iter_max);
         mps_json_int(&j, "limit_hits", c->limit_hits);
-        mps_json_num(&j, "max_relative_change_accepted", c->change_max);
+        mps_json_num(&j, "max_converged_change_over_step", c->change_max);
         /* steps that took 1, 2, 3-4, 5-8, 9-16, 17-32, 33-64, more iterations */
         mps_json_array(&j, "histogram");
         for (int b = 0; b < 8; b++)
