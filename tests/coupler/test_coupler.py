@@ -234,6 +234,19 @@ def t_no_rollback():
     rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid --no-rollback',
                    '--set', 'end_time=0.01'])
     check(rc == 0, f'the same solid runs explicit (exit {rc}) {err.strip()[-200:]}')
+    # what the solvers cannot roll back: fracture (the coupler refuses the
+    # case, naming the key) and a PPE solver with a history (the fluid
+    # refuses rollback=on with an input ERROR before READY)
+    for sets, what in ((['solid.eps_max=0.1'], 'coupling.scheme'),
+                       (['fluid.ppe_solver=cholmod_reuse'], 'cholmod_reuse')):
+        out = tempfile.mkdtemp(prefix='cpl_noroll_')
+        args = [SCENE, '--out', out, '--quiet', '--set', 'coupling.scheme=implicit',
+                '--set', 'end_time=0.01']
+        for x in sets:
+            args += ['--set', x]
+        rc, err = run(args)
+        line = err.strip().splitlines()[0] if err.strip() else ''
+        check(rc == 2 and what in err, f'{sets[0]} with implicit coupling: exit {rc}, {line[:200]}')
 
 
 def t_implicit_fake():
