@@ -124,8 +124,18 @@ def outcome(out, end, bound=None):
             ok = False
             what = f'tip beyond {100 * bound:.1f} cm at {d["time"][big][0]:.3f} s'
     if s.get('status') != 'ok':
-        what = grew(d, t) + (s.get('message', '').split(': ', 1)[-1][:110])
+        what = grew(d, t) + solid_energy(out) + (s.get('message', '').split(': ', 1)[-1][:110])
     return t, ok, what
+
+
+def solid_energy(out):
+    """The solid's kinetic energy when the run stopped (its summary), for a
+    failed run: the plate's particles may have blown up while the tip probe
+    (one corner) stayed calm."""
+    ss = summary(out, 'solid_summary.json')
+    fin = ((ss or {}).get('model_summary') or {}).get('final') or {}
+    return ('solid kinetic energy at the end %.3g J/m; ' % fin['kinetic_energy']
+            if 'kinetic_energy' in fin else '')
 
 
 def grew(d, t_end):
@@ -266,7 +276,7 @@ def light():
                                           scheme_sets(sch, acc))
     ref_key = (min(dps()), 'implicit', 'aitken')
     ref = probes(outs[ref_key])
-    rows, curves = [], []
+    rows, curves, calm = [], [], []
     for (dp, sch, acc), out in outs.items():
         s, d = summary(out), probes(out)
         t, ok, what = outcome(out, 1.0, bound=PLATE_TOP)
@@ -282,6 +292,9 @@ def light():
             err = 'reference' if out == outs[ref_key] else '-'
         rows.append([sch, acc or '-', mm(dp), '%.3f s' % t, 'yes' if ok else '**no**',
                      what or '-', pk, tipmax, err, iters(s), wall(s), load_avg(out)])
+        fin = ((summary(out, 'solid_summary.json') or {}).get('model_summary') or {}).get('final')
+        if fin and ok:
+            calm.append(fin['kinetic_energy'])
         if d is not None:
             curves.append((f'{sch}{" " + acc if acc else ""}, {mm(dp)}', d))
     plot('hard_light_plate.png', curves, 'light plate (rho_s = 100): tip_dx')
@@ -294,6 +307,9 @@ def light():
     lines += table(['scheme', 'acceleration', 'dp', 'reached', 'stable', 'failure: what grew, '
                     'then the error', 'first peak', 'max abs tip (cm)', 'tip RMS vs reference '
                     '(cm)', 'iterations', 'wall (s)', 'load'], rows)
+    if calm:
+        lines += ['', 'The solid\'s kinetic energy at 1 s in the stable runs: %.2g-%.2g J/m.'
+                  % (min(calm), max(calm))]
     lines += ['', '![light plate](img/hard_light_plate.png)', '',
               'Commands (RUNS = the --runs directory):', '']
     lines += ['    ' + command(o) for o in outs.values()]
@@ -659,6 +675,10 @@ def rest():
     for dp in dps():
         curves.append((f'analytic, {mm(dp)}', {'time': np.array([0, 5]),
                                                'tip_dx': np.array([1, 1]) * rest_analytic(dp)}))
+        alone = rest_solid_alone(dp)
+        if alone:
+            curves.append((f'solid alone, {mm(dp)}', {'time': np.array([0, 5]), 'tip_dx':
+                                                      np.array([1, 1]) * alone['probes']['tip_dx']}))
     plot('hard_plate_at_rest.png', curves, 'plate at rest: tip_dx', scale=1e3, unit='mm')
     lines = ['## 4. The plate at rest (`cases/hard_plate_at_rest`)', '',
              'Water 72 mm deep left of the plate and 24 mm right of it (both below its top, '
