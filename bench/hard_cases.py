@@ -222,7 +222,8 @@ def standard():
     case = 'cases/dambreak_elastic_plate/case.yml'
     outs = {}
     for dp in dps():
-        for sch, acc in SCHEMES:
+        # IQN-ILS at the coarse spacing only (the finer run costs a long time)
+        for sch, acc in SCHEMES if dp == max(dps()) else SCHEMES[:2]:
             name = f'std_{sch}{"_" + acc if acc else ""}_{int(dp * 1e4)}'
             outs[(dp, sch, acc)] = coupler(name, case, [f'dp={dp}', 'output.interval=0'] +
                                            scheme_sets(sch, acc))
@@ -422,7 +423,8 @@ def stiff():
     for dp, out in rigid.items():
         s = summary(out)
         rig_rows.append([mm(dp), outcome(out, 1.0)[2] or 'ok', wall(s)])
-    plot('hard_stiff_plate.png', curves, 'stiff plate (E = 1 GPa): tip_dx', scale=1e6, unit='um')
+    plot('hard_stiff_plate.png', curves, 'stiff plate (E = 1 GPa): tip_dx, running mean over '
+         '10 ms', scale=1e6, unit='um', smooth=0.01)
     lines = ['## 2. The stiff plate (`cases/hard_stiff_plate`, E = 1 GPa)', '',
              'The dam-break plate a thousand times stiffer, to 1 s. Sub-cycles: solid steps per '
              'coupling iteration. Time split: the solid\'s and the fluid\'s compute seconds '
@@ -728,7 +730,9 @@ def sloshing():
 
 # ---------------------------------------------------------------- plots and main
 
-def plot(name, curves, title, scale=100.0, unit='cm'):
+def plot(name, curves, title, scale=100.0, unit='cm', smooth=0.0):
+    """tip_dx of each run against time; smooth > 0: its running mean over
+    that many seconds (for noisy loads)."""
     if not curves:
         return
     import matplotlib
@@ -736,7 +740,11 @@ def plot(name, curves, title, scale=100.0, unit='cm'):
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 4.2))
     for label, d in curves:
-        ax.plot(d['time'], scale * np.asarray(d['tip_dx']), lw=0.9, label=label)
+        t, y = np.asarray(d['time']), scale * np.asarray(d['tip_dx'])
+        if smooth > 0 and len(t) > 2:
+            k = max(1, int(round(smooth / np.median(np.diff(t)))))
+            y = np.convolve(y, np.ones(k) / k, mode='same')
+        ax.plot(t, y, lw=0.9, label=label)
     ax.set_xlabel('t (s)')
     ax.set_ylabel(f'tip_dx ({unit})')
     ax.set_title(title)
