@@ -90,7 +90,9 @@ def probes(out):
     p = os.path.join(out, 'probes.csv')
     if not os.path.exists(p) or os.path.getsize(p) == 0:
         return None
-    d = np.genfromtxt(p, delimiter=',', names=True)
+    with open(p) as f:  # '#' lines: provenance
+        d = np.genfromtxt((line for line in f if not line.startswith('#')), delimiter=',',
+                          names=True)
     return d if d.size > 1 else None
 
 

@@ -31,7 +31,9 @@ def main():
     ap.add_argument('--expect-unstable', action='store_true')
     a = ap.parse_args()
     s = json.load(open(os.path.join(a.run, 'summary.json')))
-    d = np.genfromtxt(os.path.join(a.run, 'probes.csv'), delimiter=',', names=True)
+    with open(os.path.join(a.run, 'probes.csv')) as f:  # '#' lines: provenance
+        d = np.genfromtxt((line for line in f if not line.startswith('#')), delimiter=',',
+                          names=True)
     t, tip = d['time'], d['tip_dx']
     fails = []
     reached = s.get('simulated_time', 0.0)

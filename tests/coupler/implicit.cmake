@@ -24,14 +24,17 @@ add_executable(solid_static_load ${CMAKE_SOURCE_DIR}/bench/solid_static_load.c)
 target_link_libraries(solid_static_load PRIVATE solidcore m)
 set_target_properties(solid_static_load PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bench)
 
-# The light plate (cases/hard_light_plate) at 6 mm with rho_s = 50 kg/m3,
-# where the explicit scheme diverges at 0.34 s (the fluid's step collapses as
-# the force on the plate swings from step to step: docs/hard_cases.md). The
+# The light plate (cases/hard_light_plate) at 6 mm with rho_s = 10 kg/m3 (a
+# hundredth of the water's), where the explicit scheme diverges at 0.28 s (the
+# fluid's step collapses below dt_min as the plate, beyond its height, whips
+# the water: docs/hard_cases.md; at rho_s = 25 it still reached 0.45 s, and
+# at 50, which diverged at 0.34 s before the fluid's kappa_dt, too). The
 # implicit run must reach 0.45 s (the first impact and its rebound) with the
-# tip within the plate's height (8.4 cm; measured 3.6 cm) at no more than 10
-# iterations per step on average (the issue's target; measured 4.6); the
-# explicit run of the same case must not, which shows the check can fail.
-set(LIGHT "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_light_plate/case.yml --quiet --set dp=0.006 --set end_time=0.45 --set solid.bodies.0.rho=50 --set output.interval=0")
+# tip within the plate's height (8.4 cm; measured 3.5 cm) at no more than 10
+# iterations per step on average (the issue's target; measured 7.3, 19 steps
+# accepted at the limit of 20); the explicit run of the same case must not,
+# which shows the check can fail.
+set(LIGHT "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_light_plate/case.yml --quiet --set dp=0.006 --set end_time=0.45 --set solid.bodies.0.rho=10 --set output.interval=0")
 add_test(NAME coupled_light_plate_implicit
          COMMAND sh -c "${LIGHT} --out ${CMAKE_BINARY_DIR}/test_out/light_implicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_implicit --end 0.45 --tip-bound 0.084 --max-iterations-mean 10"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
