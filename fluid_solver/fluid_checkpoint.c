@@ -23,6 +23,7 @@ enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, str
     c->lost = f->lost;
     c->wall_guard = f->wall_guard;
     c->solid_placed = f->solid_placed;
+    fluid_sensors_keep(f, &c->sens);
     c->valid = 1;
     return MPS_OK;
 }
@@ -46,6 +47,7 @@ enum mps_status fluid_ckpt_restore(struct fluid *f, const struct fluid_ckpt *c,
     f->lost = c->lost;
     f->wall_guard = c->wall_guard;
     f->solid_placed = c->solid_placed;
+    fluid_sensors_back(f, &c->sens);
     return MPS_OK;
 }
 

@@ -10,7 +10,8 @@
  * the fluid and give the same physics in other bits), time, step counter
  * (the first step always rebuilds the list; the CFL step reads it), whether
  * the solid has replaced the floor under it, the load normalisation, and the
- * counters of lost particles and guard uses. Work counters (PPE iterations,
+ * counters of lost particles and guard uses, the sensors' time means
+ * (fluid_sensors.h). Work counters (PPE iterations,
  * list rebuilds, phase timers) are not rolled back: they count the work done.
  * The PPE solver keeps no state between solves except with
  * fluid.ppe_solver: cholmod_reuse (the ordering of earlier matrices), which
@@ -29,6 +30,7 @@ struct fluid_ckpt {
     double time, dt_last, load_scale;
     long step, lost, wall_guard;
     int solid_placed;
+    struct fluid_sensors_mark sens;
 };
 
 /* Copies f's state into c (zero-initialised before the first save).

@@ -31,10 +31,15 @@ enum solid_plane { SOLID_PLANE_STRAIN, SOLID_PLANE_STRESS };
 enum solid_contact { SOLID_CONTACT_NONE, SOLID_CONTACT_BODIES, SOLID_CONTACT_ALL };
 
 enum solid_probe_kind {
-    SOLID_PROBE_DX, /* x displacement, m */
-    SOLID_PROBE_DY, /* y displacement, m */
-    SOLID_PROBE_X,  /* x position, m */
-    SOLID_PROBE_Y   /* y position, m */
+    SOLID_PROBE_DX,      /* x displacement, m */
+    SOLID_PROBE_DY,      /* y displacement, m */
+    SOLID_PROBE_X,       /* x position, m */
+    SOLID_PROBE_Y,       /* y position, m */
+    /* the fluid's load on a body (or all), mean since the previous probe row
+     * (solid_loadprobe.h) */
+    SOLID_PROBE_FORCE_X, /* N per metre depth */
+    SOLID_PROBE_FORCE_Y,
+    SOLID_PROBE_MOMENT   /* about (x, y), counterclockwise positive, N m per metre */
 };
 
 struct solid_body_def {
@@ -52,7 +57,9 @@ struct solid_clamp_def {
 struct solid_probe_def {
     char name[SOLID_NAME_MAX];
     enum solid_probe_kind kind;
-    double x, y;             /* the particle(s) nearest this point at start */
+    double x, y;             /* the particle(s) nearest this point at start; moment: the
+                              * point the moment is taken about */
+    int body;                /* load kinds: index into bodies, -1 all of them */
 };
 
 struct solid_scene {
@@ -86,10 +93,14 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
 void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x0)[MPS_DIM],
                          int *probe_n, size_t (*probe_i)[SOLID_PROBE_TIES]);
 
-/* Probe k's current value: the mean over its particles of dx, dy, x or y. */
+/* Probe k's current value: the mean over its particles of dx, dy, x or y;
+ * for the load kinds, the mean load since the last restart of lp
+ * (solid_loadprobe.h). body: each particle's body. */
+struct solid_load_probes;
 double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
                          const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
-                         const double (*x0)[MPS_DIM]);
+                         const double (*x0)[MPS_DIM], const struct solid_load_probes *lp,
+                         const int *body);
 
 /* Fluid loads (force per particle, N per metre depth) as accelerations:
  * aload[i] = force / (rho_body V), V = dp^2; particles not listed get zero.

@@ -278,6 +278,7 @@ static void find_probes(struct solid_tlsph *s)
 {
     s->nprobes = s->scene.nprobes;
     solid_probes_locate(&s->scene, s->n, (const double(*)[MPS_DIM])s->x0, s->probe_n, s->probe_i);
+    solid_load_probes_init(&s->loadprobes, &s->scene);
 }
 
 enum mps_status solid_tlsph_create(struct solid_tlsph **out, const struct solid_scene *scene,
@@ -340,6 +341,7 @@ void solid_tlsph_destroy(struct solid_tlsph **sp)
     struct solid_tlsph *s = *sp;
     mps_particles_free(&s->ps);
     mps_particles_ckpt_free(&s->ckpt);
+    solid_load_probes_free(&s->loadprobes);
     free(s->pstart);
     free(s->pj);
     if (s->pgl != s->pg)
@@ -574,7 +576,8 @@ void solid_tlsph_diag(const struct solid_tlsph *s, struct solid_tlsph_diag *d)
 double solid_tlsph_probe(const struct solid_tlsph *s, int k)
 {
     return solid_probe_value(&s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
-                             (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0);
+                             (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0,
+                             &s->loadprobes, s->body);
 }
 
 /* ---- solid_model_ops ---- */
@@ -604,12 +607,21 @@ static double op_stable_dt(const void *self)
 static enum mps_status op_set_loads(void *self, const struct solid_loads *f, struct mps_err *err)
 {
     struct solid_tlsph *s = self;
-    return solid_loads_accel(&s->scene, s->body, s->n, f, s->aload, err);
+    enum mps_status st = solid_loads_accel(&s->scene, s->body, s->n, f, s->aload, err);
+    return st ? st : solid_load_probes_set(&s->loadprobes, f, err);
 }
 
 static enum mps_status op_advance(void *self, double dt, struct mps_err *err)
 {
-    return solid_tlsph_advance(self, dt, err);
+    struct solid_tlsph *s = self;
+    /* the loads act over this step from the positions it starts at */
+    solid_load_probes_step(&s->loadprobes, &s->scene, s->body, (const double(*)[MPS_DIM])s->x, dt);
+    return solid_tlsph_advance(s, dt, err);
+}
+
+static void op_probe_restart(void *self)
+{
+    solid_load_probes_restart(&((struct solid_tlsph *)self)->loadprobes);
 }
 
 /* Surface particles and those within depth of one, on the reference lattice
@@ -711,6 +723,7 @@ static enum mps_status op_save(void *self, struct mps_err *err)
     s->ckpt_vmax = s->vmax;
     s->ckpt_time = s->time;
     s->ckpt_steps = s->steps;
+    solid_load_probes_keep(&s->loadprobes, &s->ckpt_loadprobes);
     return mps_particles_save(&s->ps, &s->ckpt, err);
 }
 
@@ -722,6 +735,7 @@ static enum mps_status op_restore(void *self, struct mps_err *err)
     s->vmax = s->ckpt_vmax;
     s->time = s->ckpt_time;
     s->steps = s->ckpt_steps;
+    solid_load_probes_back(&s->loadprobes, &s->ckpt_loadprobes);
     return mps_particles_restore(&s->ps, &s->ckpt, err);
 }
 
@@ -742,6 +756,7 @@ const struct solid_model_ops solid_tlsph_ops = {
     .probe_count = op_probe_count,
     .probe_name = op_probe_name,
     .probe_value = op_probe_value,
+    .probe_restart = op_probe_restart,
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
