@@ -153,7 +153,7 @@ def grew(d, t_end):
                      f'{np.max(d["max_speed"][late]):.3g} m/s')
     if 'solid_fx' in d.dtype.names and early.any() and late.any():
         f = np.hypot(d['solid_fx'], d['solid_fy'])
-        parts.append(f'|force on solid| {np.max(f[early]):.3g} -> {np.max(f[late]):.3g} N/m')
+        parts.append(f'force on solid (magnitude) {np.max(f[early]):.3g} -> {np.max(f[late]):.3g} N/m')
     return ('; '.join(parts) + ' (last 50 ms); ') if parts else ''
 
 
@@ -360,6 +360,8 @@ def bisect():
             verdict = (f'At {mm(dp)} the explicit scheme is stable to 1 s for rho_s >= {hi:.0f} '
                        f'kg/m3 and not for rho_s <= {lo:.0f} kg/m3: the threshold is '
                        f'rho_s / rho_f = {lo / RHO_W:.3f}-{hi / RHO_W:.3f}.')
+        elif ok_hi is None or ok_lo is None:
+            verdict = f'At {mm(dp)}: not run.'
         else:
             verdict = (f'At {mm(dp)} the bracket {lo:g}-{hi:g} kg/m3 did not hold '
                        f'(stable at {hi:g}: {ok_hi}, at {lo:g}: {ok_lo}): no bisection.')
@@ -367,8 +369,8 @@ def bisect():
         for rho in sorted(seen):
             t, ok, what, out = seen[rho]
             rows.append([mm(dp), '%.1f' % rho, '%.3f' % (rho / RHO_W), 'n/a' if t is None else
-                         '%.3f s' % t, 'yes' if ok else '**no**', what or '-',
-                         wall(summary(out)), load_avg(out)])
+                         '%.3f s' % t, 'yes' if ok else '-' if ok is None else '**no**',
+                         what or '-', wall(summary(out)), load_avg(out)])
         lines += table(['dp', 'rho_s (kg/m3)', 'rho_s / rho_f', 'reached', 'stable',
                         'failure', 'wall (s)', 'load'], rows)
         lines += ['', verdict, '']
@@ -546,7 +548,7 @@ def gate_static():
              'water, static, against beam theory', '',
              'The gate of `cases/elastic_gate` (5 mm thick, 79 mm free, E = 12 MPa, nu = 0.4, '
              'plane strain) alone, clamped as in the case, under the pressure of still water '
-             f'14 cm deep on its upstream face scaled by {scale} (tip 0.4 mm, 0.5% of its length: '
+             f'14 cm deep on its upstream face scaled by {scale} (tip 0.4 mm, 0.5%% of its length: '
              'linear; the full load bends it 3.8 cm, where beam theory no longer holds), brought '
              'to rest (bench/solid_static_load.c). Beam theory at the probe (the centre of the '
              'bottom row): Euler-Bernoulli %.4f mm, Timoshenko (Cowper\'s kappa = %.3f) %.4f mm '
