@@ -627,6 +627,17 @@ int mps_h5_count(const struct mps_h5_series *s)
     return s ? s->count : 0;
 }
 
+enum mps_status mps_h5_rewind(struct mps_h5_series *s, int count, struct mps_err *err)
+{
+    if (!s || count >= s->count)
+        return MPS_OK;
+    if (count < 0)
+        count = 0;
+    while (s->count > count)
+        free(s->grids[--s->count]);
+    return write_index(s, err);
+}
+
 void mps_h5_close(struct mps_h5_series **s)
 {
     if (!s || !*s)

@@ -53,6 +53,12 @@ enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, si
 /* Number of snapshots written so far. */
 int mps_h5_count(const struct mps_h5_series *s);
 
+/* Forgets the snapshots after the first count (a solver that rolled back to
+ * an earlier state: implicit coupling repeats a step). The index is rewritten
+ * without them and the next write reuses their names, overwriting the files.
+ * count >= the current count does nothing. NULL ok. */
+enum mps_status mps_h5_rewind(struct mps_h5_series *s, int count, struct mps_err *err);
+
 /* Closes the series (XDMF is already complete); accepts NULL, sets *s NULL. */
 void mps_h5_close(struct mps_h5_series **s);
 

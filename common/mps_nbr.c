@@ -613,6 +613,30 @@ void mps_nbr_list_free(struct mps_nbr_list *l)
     memset(l, 0, sizeof *l);
 }
 
+enum mps_status mps_nbr_list_copy(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+                                  struct mps_err *err)
+{
+    const size_t n = src->n, npairs = src->start ? src->start[n] : 0;
+    dst->no_r2 = src->no_r2 || !src->r2;
+    if (!dst->no_r2 && !dst->r2)
+        dst->cap_pairs = 0; /* j may have room, r2 has none yet */
+    if (grow((void **)&dst->start, &dst->cap_n, n + 1, sizeof(size_t)) || grow_pairs(dst, npairs))
+        return mps_err_set(err, MPS_ENOMEM, "neighbour list: out of memory copying %zu pairs",
+                           npairs);
+    dst->n = n;
+    dst->radius = src->radius;
+    if (src->start)
+        memcpy(dst->start, src->start, (n + 1) * sizeof *dst->start);
+    else
+        dst->start[0] = 0;
+    if (npairs) {
+        memcpy(dst->j, src->j, npairs * sizeof *dst->j);
+        if (!dst->no_r2)
+            memcpy(dst->r2, src->r2, npairs * sizeof *dst->r2);
+    }
+    return MPS_OK;
+}
+
 enum mps_status mps_nbr_grid_cell_order(struct mps_nbr_grid *g, size_t m, size_t *perm,
                                         struct mps_err *err)
 {

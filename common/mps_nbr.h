@@ -85,6 +85,11 @@ enum mps_status mps_nbr_list_reverse(struct mps_nbr_list *dst, const struct mps_
                                      struct mps_err *err);
 void mps_nbr_list_free(struct mps_nbr_list *l);
 
+/* dst becomes a copy of src's rows (start, j, and r2 if src keeps it): a
+ * solver's checkpoint of a list it would otherwise rebuild differently. */
+enum mps_status mps_nbr_list_copy(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
+                                  struct mps_err *err);
+
 /* The pairs of src that are closer than radius at positions x (which may have
  * moved since src was built: r2 is recomputed), kept in src's order. Used to
  * derive a short-radius list from a long-radius list with a skin. If src

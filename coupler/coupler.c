@@ -8,8 +8,10 @@
  * them over ZeroMQ (proto/PROTOCOL.md) and owns simulation time: each step
  * the fluid advances with the solid's interface as its moving boundary, and
  * the solid sub-cycles over the same interval under the fluid's loads
- * (paper 4.5, partitioned weak coupling). Exit: 0 done, 2 bad input,
- * 1 failure (a solver died, diverged or timed out), 130 interrupted. */
+ * (paper 4.5, partitioned weak coupling; with coupling.scheme: implicit the
+ * step is repeated from its start until the interface converges,
+ * coupling_iter.h). Exit: 0 done, 2 bad input, 1 failure (a solver died,
+ * diverged or timed out), 130 interrupted. */
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -22,6 +24,8 @@
 
 #include "coupler_keys.h"
 #include "coupler_record.h"
+#include "coupling_accel.h"
+#include "coupling_iter.h"
 #include "fluid_params.h"
 #include "guard.h"
 #include "launch.h"
@@ -62,7 +66,9 @@ struct peer {
     char probe_names[MAX_PROBES][64];
     double probes[MAX_PROBES];
     double roundtrip_seconds;  /* ADVANCE sent -> RESULT received */
+    double repeat_seconds;     /* the part of it in repeated iterations (implicit) */
     long exchanges;
+    int can_rollback;          /* HELLO declared caps=rollback */
     char *bye;                 /* its summary JSON */
     char model[64];            /* as its HELLO announced it */
 };
@@ -92,6 +98,19 @@ struct coupler {
     long step;
     double wall0;
     char failed_peer[16];
+    /* implicit coupling (coupling.scheme: implicit) */
+    int implicit;
+    struct coupling_iter iter;
+    struct coupling_accel *accel;
+    int max_iter, on_max_error;
+    long iterations;           /* fluid and solid solve pairs, all steps */
+    int iter_max;              /* most in one step */
+    long limit_hits;           /* steps accepted at max_iterations */
+    long iter_hist[8];         /* steps that took 1, 2, 3-4, 5-8, 9-16, 17-32, 33-64, more */
+    double accel_seconds;      /* in the coupler's own vector work */
+    double change_max;         /* largest converged rms change / step's displacement */
+    long iter_probe_sum, iter_probe_steps; /* for the probe column */
+    FILE *iter_log;            /* coupling.implicit.log: OUT/iterations.csv */
 };
 
 static volatile int interrupted = 0;
@@ -324,10 +343,29 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
         return mps_err_set(err, MPS_EPROTO, "%s", reason);
     }
+    /* PROTOCOL.md 4: caps=a,b,... (absent: none) */
+    char caps[256];
+    p->can_rollback = 0;
+    if (proto_text_get(m.text, ' ', "caps", caps, sizeof caps) == 1)
+        for (char *tok = strtok(caps, ","); tok; tok = strtok(NULL, ","))
+            p->can_rollback |= strcmp(tok, "rollback") == 0;
     char model[64] = "";
     proto_text_get(m.text, ' ', "model", model, sizeof model);
     snprintf(p->model, sizeof p->model, "%s", model);
     proto_msg_clear(&m);
+    if (c->implicit && !p->can_rollback) {
+        char reason[512];
+        snprintf(reason, sizeof reason,
+                 "coupling.scheme is implicit, which repeats steps, and this %s solver cannot "
+                 "(its HELLO declares no caps=rollback): run it with coupling.scheme: explicit "
+                 "(PROTOCOL.md 4, 6)",
+                 p->name);
+        struct proto_msg r = proto_msg_make(PROTO_REJECT);
+        r.text = reason;
+        proto_link_send(p->sock, &r, err);
+        snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
+        return mps_err_set(err, MPS_EINPUT, "%s", reason);
+    }
     /* the file this solver is about to read records its own run */
     enum mps_status rst = coupler_record_hello(
         &c->rec, &c->cs, c->tables, 4, k,
@@ -335,8 +373,9 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     if (rst)
         return rst;
     char cfg[8192];
-    snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n", resolved_case,
-             c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0));
+    snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n%s", resolved_case,
+             c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0),
+             c->implicit ? "rollback=on\n" : "");
     struct proto_msg conf = proto_msg_make(PROTO_CONFIG);
     conf.text = cfg;
     return proto_link_send(p->sock, &conf, err);
@@ -368,6 +407,11 @@ static enum mps_status await_ready(struct coupler *c, int k, struct mps_err *err
             return mps_err_set(err, MPS_EPROTO, "solid READY carries no STATE");
         }
         c->state = m; /* keep: it is the fluid's first boundary */
+        if (c->implicit)
+            return coupling_iter_init(&c->iter, &m,
+                                      mps_case_double(c->cs, "coupling.implicit.tolerance"),
+                                      mps_case_double(c->cs, "coupling.implicit.abs_tolerance"),
+                                      err);
         return MPS_OK;
     }
     proto_msg_clear(&m);
@@ -389,13 +433,17 @@ static enum mps_status exchange(struct coupler *c, int k, struct proto_msg *adv,
     if ((st = expect(c, k, res, PROTO_RESULT, c->step_timeout, err)))
         return st;
     p->roundtrip_seconds += mps_wall_seconds() - t0;
+    if (adv->iteration > 0)
+        p->repeat_seconds += mps_wall_seconds() - t0;
     p->exchanges++;
-    if (res->step != adv->step || res->time != adv->time + adv->dt) {
+    if (res->step != adv->step || res->iteration != adv->iteration ||
+        res->time != adv->time + adv->dt) {
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
         return mps_err_set(err, MPS_EPROTO,
-                           "%s RESULT is for step %lld at t = %.17g, expected step %lld at %.17g",
-                           p->name, (long long)res->step, res->time, (long long)adv->step,
-                           adv->time + adv->dt);
+                           "%s RESULT is for step %lld iteration %d at t = %.17g, expected step "
+                           "%lld iteration %d at %.17g",
+                           p->name, (long long)res->step, res->iteration, res->time,
+                           (long long)adv->step, adv->iteration, adv->time + adv->dt);
     }
     if (!(res->dt > 0.0)) {
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
@@ -411,7 +459,7 @@ static enum mps_status exchange(struct coupler *c, int k, struct proto_msg *adv,
 
 static enum mps_status write_probe_row(struct coupler *c, struct mps_err *err)
 {
-    double v[2 * MAX_PROBES + MPS_DIM];
+    double v[2 * MAX_PROBES + MPS_DIM + 1];
     int n = 0;
     for (int k = 0; k < NPEERS; k++)
         if (c->p[k].needed)
@@ -424,12 +472,16 @@ static enum mps_status write_probe_row(struct coupler *c, struct mps_err *err)
         }
         c->impulse_time = 0.0;
     }
+    if (c->implicit) { /* mean iterations per step since the last row */
+        v[n++] = c->iter_probe_steps ? (double)c->iter_probe_sum / c->iter_probe_steps : 0.0;
+        c->iter_probe_sum = c->iter_probe_steps = 0;
+    }
     return mps_probes_write(c->probes, c->time, v, err);
 }
 
 static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
 {
-    const char *names[2 * MAX_PROBES + MPS_DIM];
+    const char *names[2 * MAX_PROBES + MPS_DIM + 1];
     int n = 0;
     for (int k = 0; k < NPEERS; k++)
         if (c->p[k].needed)
@@ -439,6 +491,8 @@ static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
         names[n++] = "solid_fx";
         names[n++] = "solid_fy";
     }
+    if (c->implicit)
+        names[n++] = "coupling_iterations";
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", c->out);
     char *comment = mps_prov_comment(c->cs, "coupler");
@@ -462,6 +516,130 @@ static double next_dt(const struct coupler *c, double t_next, double probe_inter
     if (left < 2.0 * dt)
         return 0.5 * left;
     return dt;
+}
+
+/* Sub-cycles from the solid's own stable step (paper 4.6). */
+static int solid_substeps(const struct coupler *c, double dt)
+{
+    double n = ceil(dt / c->p[SOLID].dt * (1.0 - 1e-12));
+    return n < 1.0 ? 1 : (int)n;
+}
+
+/* The fluid's loads for the solid's ADVANCE, as built from adv. */
+static struct proto_msg solid_advance(const struct coupler *c, const struct proto_msg *adv,
+                                      int n_sub)
+{
+    struct proto_msg sadv = *adv;
+    sadv.payload = c->p[FLUID].needed ? PROTO_LOADS : PROTO_NONE;
+    sadv.count = c->p[FLUID].needed ? c->loads.count : 0;
+    sadv.id = c->loads.id;
+    sadv.pressure = c->loads.pressure;
+    sadv.force = c->loads.force;
+    sadv.x = sadv.v = NULL;
+    sadv.surface = sadv.fixed = NULL;
+    sadv.n_sub = n_sub;
+    return sadv;
+}
+
+static void count_iterations(struct coupler *c, int k)
+{
+    c->iterations += k;
+    c->iter_probe_sum += k;
+    c->iter_probe_steps++;
+    if (k > c->iter_max)
+        c->iter_max = k;
+    int b = 0;
+    while (b < 7 && k > (1 << b))
+        b++;
+    c->iter_hist[b]++;
+}
+
+/* One step of implicit coupling (coupling_iter.h): the fluid and the solid
+ * repeat the step from its start, the coupler choosing the solid state the
+ * fluid sees, until the solid's answer agrees with it. The solid's last
+ * answer and the fluid's last loads (those it answered) are kept; the
+ * solvers are then at that iteration's end. dt, the solid's sub-steps and
+ * the flags stay those of the first iteration, so a repeat is the same step. */
+static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
+                                     struct mps_err *err)
+{
+    const int n_sub = solid_substeps(c, adv->dt);
+    struct proto_msg send;
+    double a0 = mps_wall_seconds();
+    enum mps_status st = coupling_iter_start(&c->iter, &c->state, adv->dt, &send, err);
+    if (!st)
+        st = coupling_accel_begin(c->accel, coupling_iter_len(&c->iter), err);
+    c->accel_seconds += mps_wall_seconds() - a0;
+    if (st)
+        return st;
+    int k = 0, converged = 0, rerun = 0;
+    for (;;) {
+        adv->iteration = k;
+        adv->payload = PROTO_STATE;
+        adv->count = send.count;
+        adv->id = send.id;
+        adv->x = send.x;
+        adv->v = send.v;
+        adv->surface = send.surface;
+        adv->fixed = send.fixed;
+        struct proto_msg res = {0};
+        if ((st = exchange(c, FLUID, adv, &res, err)))
+            return st;
+        proto_msg_clear(&c->loads);
+        c->loads = res;
+        struct proto_msg sadv = solid_advance(c, adv, n_sub);
+        res = (struct proto_msg){0};
+        if ((st = exchange(c, SOLID, &sadv, &res, err)))
+            return st;
+        proto_msg_clear(&c->state);
+        c->state = res;
+        k++;
+        a0 = mps_wall_seconds();
+        st = coupling_iter_result(&c->iter, &c->state, &converged, err);
+        if (!st && !converged && k < c->max_iter)
+            st = coupling_iter_relax(&c->iter, c->accel, &send, err);
+        c->accel_seconds += mps_wall_seconds() - a0;
+        if (!st && !converged && k >= c->max_iter && !rerun && !c->on_max_error)
+            rerun = coupling_iter_best(&c->iter, &send); /* once more with the best */
+        if (c->iter_log)
+            fprintf(c->iter_log, "%ld,%.9g,%d,%.6e,%.6e,%.6e,%.6g\n", c->step, c->time, k - 1,
+                    c->iter.change, c->iter.increment, c->iter.displacement,
+                    converged || k >= c->max_iter ? 0.0 : coupling_accel_last(c->accel));
+        if (st)
+            return mps_err_prefix(err, "step %ld at t = %.6g s, iteration %d: ", c->step,
+                                  c->time, k - 1);
+        if (converged || (k >= c->max_iter && rerun != 1))
+            break;
+        if (rerun == 1)
+            rerun = 2; /* the repeat of the best is sent now; accepted whatever it gives */
+    }
+    coupling_accel_end(c->accel);
+    count_iterations(c, k);
+    double rel = c->iter.increment > 0.0 ? c->iter.change / c->iter.increment : 0.0;
+    if (!converged) {
+        if (c->on_max_error)
+            return mps_err_set(err, MPS_EDIVERGED,
+                               "implicit coupling did not converge in %d iterations at step %ld, "
+                               "t = %.6g s: rms change of the interface %.3g m against a "
+                               "displacement of %.3g m over the step (coupling.implicit.tolerance "
+                               "%g, abs_tolerance %g m/s; coupling.implicit.on_max: error)",
+                               k, c->step, c->time, c->iter.change, c->iter.increment,
+                               c->iter.tol, c->iter.atol);
+        if (c->limit_hits++ == 0 && !c->quiet)
+            fprintf(stderr,
+                    "\ncoupler: warning: step %ld at t = %.6g s not converged in %d iterations "
+                    "(rms change %.3g m, displacement over the step %.3g m): accepted "
+                    "(coupling.implicit.on_max: accept); such steps are counted in "
+                    "summary.json\n",
+                    c->step, c->time, k, c->iter.change, c->iter.increment);
+    } else if (rel > c->change_max) {
+        c->change_max = rel;
+    }
+    for (size_t q = 0; q < c->loads.count; q++)
+        for (int a = 0; a < MPS_DIM; a++)
+            c->impulse[a] += adv->dt * c->loads.force[q][a];
+    c->impulse_time += adv->dt;
+    return MPS_OK;
 }
 
 static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
@@ -495,7 +673,10 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
         adv.dt = dt;
         adv.n_sub = 1;
         adv.flags = flags;
-        if (c->p[FLUID].needed) {
+        if (c->implicit) {
+            if ((st = implicit_step(c, &adv, err)))
+                return st;
+        } else if (c->p[FLUID].needed) {
             if (c->p[SOLID].needed) {
                 adv.payload = PROTO_STATE;
                 adv.count = c->state.count;
@@ -515,18 +696,8 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
                     c->impulse[a] += dt * c->loads.force[q][a];
             c->impulse_time += dt;
         }
-        if (c->p[SOLID].needed) {
-            struct proto_msg sadv = adv;
-            sadv.payload = c->p[FLUID].needed ? PROTO_LOADS : PROTO_NONE;
-            sadv.count = c->p[FLUID].needed ? c->loads.count : 0;
-            sadv.id = c->loads.id;
-            sadv.pressure = c->loads.pressure;
-            sadv.force = c->loads.force;
-            sadv.x = sadv.v = NULL;
-            sadv.surface = sadv.fixed = NULL;
-            /* Sub-cycles from the solid's own stable step (paper 4.6). */
-            double n = ceil(dt / c->p[SOLID].dt * (1.0 - 1e-12));
-            sadv.n_sub = n < 1.0 ? 1 : (int)n;
+        if (!c->implicit && c->p[SOLID].needed) {
+            struct proto_msg sadv = solid_advance(c, &adv, solid_substeps(c, dt));
             if ((st = exchange(c, SOLID, &sadv, &res, err)))
                 return st;
             proto_msg_clear(&c->state);
@@ -667,6 +838,35 @@ static void write_summary_json(struct coupler *c, enum mps_status st, const stru
     mps_json_num(&j, "coupler_other", wall - solvers - msg);
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
+    /* iterations per step: 1 for the explicit scheme */
+    mps_json_object(&j, "iterations");
+    mps_json_str(&j, "scheme", c->implicit ? "implicit" : "explicit");
+    if (c->implicit) {
+        mps_json_str(&j, "acceleration", c->accel ? coupling_accel_name(c->accel) : "");
+        mps_json_int(&j, "steps", c->step);
+        mps_json_int(&j, "total", c->iterations);
+        mps_json_num(&j, "mean", c->step ? (double)c->iterations / c->step : 0.0);
+        mps_json_int(&j, "max", c->iter_max);
+        mps_json_int(&j, "limit_hits", c->limit_hits);
+        mps_json_num(&j, "max_converged_change_over_step", c->change_max);
+        /* steps that took 1, 2, 3-4, 5-8, 9-16, 17-32, 33-64, more iterations */
+        mps_json_array(&j, "histogram");
+        for (int b = 0; b < 8; b++)
+            mps_json_int(&j, NULL, c->iter_hist[b]);
+        mps_json_close(&j);
+        mps_json_num(&j, "acceleration_seconds", c->accel_seconds);
+        for (int k = 0; k < NPEERS; k++)
+            if (c->p[k].needed) {
+                char key[64];
+                snprintf(key, sizeof key, "%s_repeat_roundtrip_seconds", c->p[k].name);
+                mps_json_num(&j, key, c->p[k].repeat_seconds);
+            }
+    } else {
+        mps_json_int(&j, "steps", c->step);
+        mps_json_num(&j, "mean", 1.0);
+        mps_json_int(&j, "max", c->step ? 1 : 0);
+    }
+    mps_json_close(&j);
     if (c->p[FLUID].bye) /* from the fluid's summary, as on the terminal */
         mps_json_int(&j, "lost_particles",
                      (long long)bye_number(&c->p[FLUID], "lost_particles", 0.0));
@@ -758,6 +958,10 @@ static void cleanup(struct coupler *c)
         rmdir(c->rundir);
     proto_msg_clear(&c->state);
     proto_msg_clear(&c->loads);
+    coupling_iter_free(&c->iter);
+    coupling_accel_destroy(&c->accel);
+    if (c->iter_log)
+        fclose(c->iter_log);
     mps_probes_close(&c->probes);
     mps_case_destroy(&c->cs);
 }
@@ -818,6 +1022,9 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
      * its part. */
     c->p[FLUID].needed = mps_case_has(c->cs, "fluid.tank.width");
     c->p[SOLID].needed = mps_case_count(c->cs, "solid.bodies") > 0;
+    c->implicit = strcmp(mps_case_string(c->cs, "coupling.scheme"), "implicit") == 0;
+    c->max_iter = (int)mps_case_int(c->cs, "coupling.implicit.max_iterations");
+    c->on_max_error = strcmp(mps_case_string(c->cs, "coupling.implicit.on_max"), "error") == 0;
     const char *ext = opt[OPT_EXTERNAL].value;
     if (ext && strcmp(ext, "fluid") && strcmp(ext, "solid"))
         return mps_err_set(err, MPS_EINPUT, "--external %s: must be fluid or solid", ext);
@@ -845,6 +1052,16 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
         st = solid_scene_read(sc, c->cs, err);
     if (!st && sc && c->p[FLUID].needed)
         st = scene_check_fsi(&fp, sc, c->cs, err);
+    /* implicit coupling iterates on a fixed interface (coupling_iter.h):
+     * fracture changes it, and the MPS solid does not roll it back */
+    if (!st && c->implicit && !(c->p[FLUID].needed && c->p[SOLID].needed))
+        st = mps_case_fail(c->cs, err, "coupling.scheme",
+                           "implicit coupling needs a fluid and a solid");
+    if (!st && c->implicit && (sc->eps_max > 0.0 || sc->contact != SOLID_CONTACT_NONE))
+        st = mps_case_fail(c->cs, err, "coupling.scheme",
+                           "implicit coupling cannot be used with fracture or contact "
+                           "(solid.eps_max, solid.contact): the interface would change "
+                           "within a step");
     free(sc);
     return st;
 }
@@ -854,8 +1071,15 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
 static enum mps_status start_run(struct coupler *c, struct mps_err *err)
 {
     const char *resolved = c->rec.path;
-    enum mps_status st = mps_mkdir_p(c->out, err);
-    if (st)
+    enum mps_status st;
+    if (c->implicit &&
+        (st = coupling_accel_create(&c->accel,
+                                    mps_case_string(c->cs, "coupling.implicit.acceleration"),
+                                    mps_case_double(c->cs, "coupling.implicit.relaxation"),
+                                    (int)mps_case_int(c->cs, "coupling.implicit.reuse"),
+                                    mps_case_double(c->cs, "coupling.implicit.filter"), err)))
+        return st;
+    if ((st = mps_mkdir_p(c->out, err)))
         return st;
     char abs_out[4096];
     if (!mps_realpath(c->out, abs_out, sizeof abs_out))
@@ -910,6 +1134,17 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
             return st;
     if ((st = open_probes(c, err)))
         return st;
+    if (c->implicit && mps_case_bool(c->cs, "coupling.implicit.log")) {
+        char path[4200];
+        snprintf(path, sizeof path, "%s/iterations.csv", c->out);
+        if (!(c->iter_log = fopen(path, "w")))
+            return mps_err_set(err, MPS_EIO, "cannot create %s: %s", path, strerror(errno));
+        /* factor: the relaxation factor (constant, aitken) or the columns
+         * (iqn_ils) that chose the next iterate; 0 on the step's last */
+        fputs("step,time,iteration,change_rms_m,step_displacement_rms_m,displacement_rms_m,"
+              "factor\n",
+              c->iter_log);
+    }
     if (!c->quiet)
         fprintf(stderr, "coupler: %s%s%s, output in %s\n", c->p[FLUID].needed ? "fluid" : "",
                 c->p[FLUID].needed && c->p[SOLID].needed ? " + " : "",

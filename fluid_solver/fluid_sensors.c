@@ -469,6 +469,28 @@ void fluid_sensors_restart(const struct fluid *f)
     s->time = 0.0;
 }
 
+void fluid_sensors_keep(const struct fluid *f, struct fluid_sensors_mark *m)
+{
+    const struct fluid_sensors *s = f->sens;
+    if (!s)
+        return;
+    memcpy(m->sum, s->sum, sizeof m->sum);
+    m->time = s->time;
+    memcpy(m->anchor, s->anchor, sizeof m->anchor);
+    memcpy(m->offset, s->offset, sizeof m->offset);
+}
+
+void fluid_sensors_back(const struct fluid *f, const struct fluid_sensors_mark *m)
+{
+    struct fluid_sensors *s = f->sens;
+    if (!s)
+        return;
+    memcpy(s->sum, m->sum, sizeof s->sum);
+    s->time = m->time;
+    memcpy(s->anchor, m->anchor, sizeof s->anchor);
+    memcpy(s->offset, m->offset, sizeof s->offset);
+}
+
 void fluid_sensors_summary(const struct fluid *f, struct mps_json *j)
 {
     const struct fluid_sensors *s = f->sens;

@@ -45,6 +45,18 @@ double fluid_sensors_value(const struct fluid *f, int k);
 /* A probe row was written: the means start again. */
 void fluid_sensors_restart(const struct fluid *f);
 
+/* What a repeated coupling step returns to (implicit coupling, the fluid's
+ * checkpoint): the means so far and where the sensors on a solid are
+ * anchored. */
+struct fluid_sensors_mark {
+    double sum[FLUID_MAX_PROBES];
+    double time;
+    int anchor[FLUID_MAX_PROBES];
+    double offset[FLUID_MAX_PROBES];
+};
+void fluid_sensors_keep(const struct fluid *f, struct fluid_sensors_mark *m);
+void fluid_sensors_back(const struct fluid *f, const struct fluid_sensors_mark *m);
+
 /* Where each pressure sensor sits, as resolved ("sensors" in summary.json). */
 void fluid_sensors_summary(const struct fluid *f, struct mps_json *j);
 

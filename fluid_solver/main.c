@@ -11,6 +11,7 @@
 #include <string.h>
 
 #include "fluid.h"
+#include "fluid_checkpoint.h"
 #include "fluid_ppe.h"
 #include "mps_case.h"
 #include "mps_cli.h"
@@ -51,6 +52,10 @@ struct run {
     char out_buf[4096];
     char probe_names[4096];
     char cpu_note[96];   /* what mps_omp_bind_threads did (standalone runs) */
+    /* implicit coupling: the state at the step's start, and the snapshots
+     * written by then (a repeated step writes its snapshot again) */
+    struct fluid_ckpt ckpt;
+    int saved_snapshots;
 };
 
 /* The fluid and its tank, [0, nfixed_end): a coupled solid's particles, the
@@ -112,6 +117,10 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
         mps_json_num(&j, "setup_seconds", r->peer.setup_seconds);
         mps_json_num(&j, "compute_seconds", r->peer.compute_seconds);
         mps_json_num(&j, "wait_seconds", r->peer.wait_seconds);
+        /* implicit coupling: repeated steps are in the step and PPE counts */
+        mps_json_int(&j, "advances", r->peer.advances);
+        mps_json_int(&j, "repeated_advances", r->peer.repeats);
+        mps_json_num(&j, "rollback_seconds", r->peer.rollback_seconds);
     }
     if (r->cpu_note[0])
         mps_json_str(&j, "cpu_binding", r->cpu_note);
@@ -318,6 +327,20 @@ static enum mps_status peer_advance(void *self, const struct proto_msg *in,
     return st;
 }
 
+static enum mps_status peer_save(void *self, struct mps_err *err)
+{
+    struct run *r = self;
+    r->saved_snapshots = mps_h5_count(r->h5);
+    return fluid_ckpt_save(r->f, &r->ckpt, err);
+}
+
+static enum mps_status peer_restore(void *self, struct mps_err *err)
+{
+    struct run *r = self;
+    enum mps_status st = fluid_ckpt_restore(r->f, &r->ckpt, err);
+    return st ? st : mps_h5_rewind(r->h5, r->saved_snapshots, err);
+}
+
 static char *peer_finish(void *self, enum mps_status st, const struct mps_err *err)
 {
     struct run *r = self;
@@ -330,6 +353,7 @@ static void teardown(struct run *r)
     mps_probes_close(&r->steps);
     mps_h5_close(&r->h5);
     fluid_destroy(&r->f);
+    fluid_ckpt_free(&r->ckpt);
     mps_case_destroy(&r->cs);
     free(r->load_id);
     free(r->load_p);
@@ -341,8 +365,9 @@ static int run_coupled(const char *endpoint, int hello_timeout_ms)
     struct run r = {.out = ".", .quiet = 1, .summary_name = "fluid_summary.json", .coupled = 1};
     r.wall0 = mps_wall_seconds();
     struct mps_err err = {0};
-    static const struct proto_solver_ops ops = {"fluid", "mps", peer_configure, peer_ready,
-                                                peer_advance, peer_finish};
+    static const struct proto_solver_ops ops = {"fluid",     "mps",       peer_configure,
+                                                peer_ready,  peer_advance, peer_finish,
+                                                peer_save,   peer_restore};
     enum mps_status st =
         proto_solver_run(endpoint, &ops, &r, hello_timeout_ms, &stop_signal, &r.peer, &err);
     if (st)

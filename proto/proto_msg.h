@@ -16,7 +16,7 @@
 #include "mps_dim.h"
 #include "mps_err.h"
 
-#define PROTO_VERSION 1
+#define PROTO_VERSION 2
 #define PROTO_HEADER_LEN 80
 #define PROTO_MAX_FRAMES 8               /* header + 5 STATE arrays + probes + text */
 #define PROTO_MAX_COUNT 2147483647ull    /* particles per message (ids are i32) */

@@ -39,6 +39,44 @@ static enum mps_status recv_sliced(void *sock, struct proto_msg *m, long timeout
     }
 }
 
+/* Implicit coupling (PROTOCOL.md 6): an ADVANCE of iteration 0 starts a
+ * step, saved first when rollback is on; iteration k > 0 repeats the step of
+ * iteration k - 1 (same step, time, dt and n_sub) from its start. last holds
+ * the header of the previous ADVANCE. */
+static enum mps_status rollback(const struct proto_solver_ops *ops, void *self,
+                                const struct proto_msg *in, struct proto_msg *last,
+                                struct proto_solver_stats *stats, struct mps_err *err)
+{
+    enum mps_status st = MPS_OK;
+    if (in->iteration == 0) {
+        if (stats->rollback)
+            st = ops->save(self, err);
+    } else if (!stats->rollback) {
+        return mps_err_set(err, MPS_EPROTO,
+                           "ADVANCE step %lld iteration %d: a repeated step needs rollback=on "
+                           "in CONFIG",
+                           (long long)in->step, in->iteration);
+    } else if (in->step != last->step || in->iteration != last->iteration + 1 ||
+               in->time != last->time || in->dt != last->dt || in->n_sub != last->n_sub) {
+        return mps_err_set(err, MPS_EPROTO,
+                           "ADVANCE step %lld iteration %d at t = %.17g, dt = %.17g, n_sub %d "
+                           "does not repeat step %lld iteration %d at t = %.17g, dt = %.17g, "
+                           "n_sub %d",
+                           (long long)in->step, in->iteration, in->time, in->dt, in->n_sub,
+                           (long long)last->step, last->iteration, last->time, last->dt,
+                           last->n_sub);
+    } else {
+        st = ops->restore(self, err);
+        stats->repeats++;
+    }
+    last->step = in->step;
+    last->iteration = in->iteration;
+    last->time = in->time;
+    last->dt = in->dt;
+    last->n_sub = in->n_sub;
+    return st;
+}
+
 /* Best effort: tell the coupler why we stop. */
 static void send_error(void *sock, const struct proto_msg *last, enum mps_status st,
                        const struct mps_err *err)
@@ -69,7 +107,8 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         return mps_err_set(err, MPS_ELIB, "zmq_ctx_new failed: %s", zmq_strerror(zmq_errno()));
     void *sock = NULL;
     pid_t parent = getppid();
-    struct proto_msg in = {0}, reply;
+    struct proto_msg in = {0}, reply, last = {0};
+    last.iteration = -1; /* no ADVANCE yet */
     int configured = 0, said_error = 0;
     long timeout_ms = 1800000;
     /* tcp is authenticated with CURVE (PROTOCOL.md section 10); ipc lives in
@@ -95,8 +134,9 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         goto done;
 
     char hello[256];
-    snprintf(hello, sizeof hello, "role=%s model=%s pid=%d build=%s", ops->role, ops->model,
-             (int)getpid(), MPS_VERSION);
+    const int can_roll = ops->save && ops->restore;
+    snprintf(hello, sizeof hello, "role=%s model=%s pid=%d build=%s%s", ops->role, ops->model,
+             (int)getpid(), MPS_VERSION, can_roll ? " caps=rollback" : "");
     reply = proto_msg_make(PROTO_HELLO);
     reply.text = hello;
     if ((st = proto_link_send(sock, &reply, err)))
@@ -116,7 +156,7 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         goto fail;
     }
     {
-        char case_path[4096], out[4096], prefix[64], tms[64];
+        char case_path[4096], out[4096], prefix[64], tms[64], roll[16];
         if (proto_text_get(in.text, '\n', "case", case_path, sizeof case_path) != 1 ||
             proto_text_get(in.text, '\n', "out", out, sizeof out) != 1 ||
             proto_text_get(in.text, '\n', "prefix", prefix, sizeof prefix) != 1) {
@@ -126,14 +166,16 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         if (proto_text_get(in.text, '\n', "timeout_ms", tms, sizeof tms) == 1)
             timeout_ms = atol(tms);
         /* PROTOCOL.md 4: a key this solver does not know is an input error, not
-         * something to skip (a newer coupler may rely on it) */
+         * something to skip (a newer coupler may rely on it); rollback is known
+         * only to a solver that can roll back */
         for (const char *line = in.text; line && *line;) {
             const char *end = strchr(line, '\n'), *eq = strchr(line, '=');
             size_t len = end ? (size_t)(end - line) : strlen(line);
             size_t klen = eq && (size_t)(eq - line) < len ? (size_t)(eq - line) : len;
-            static const char *const known[] = {"case", "out", "prefix", "timeout_ms"};
+            static const char *const known[] = {"case", "out", "prefix", "timeout_ms",
+                                                "rollback"};
             int ok = len == 0;
-            for (int k = 0; k < 4 && !ok; k++)
+            for (int k = 0; k < (can_roll ? 5 : 4) && !ok; k++)
                 ok = strlen(known[k]) == klen && strncmp(line, known[k], klen) == 0;
             if (!ok) {
                 st = mps_err_set(err, MPS_EINPUT, "CONFIG key '%.*s' unknown", (int)klen, line);
@@ -141,9 +183,20 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
             }
             line = end ? end + 1 : NULL;
         }
+        if (can_roll && proto_text_get(in.text, '\n', "rollback", roll, sizeof roll) != 0) {
+            if (strcmp(roll, "on") && strcmp(roll, "off")) {
+                st = mps_err_set(err, MPS_EINPUT, "CONFIG rollback=%.15s: must be on or off",
+                                 roll);
+                goto fail;
+            }
+            stats->rollback = strcmp(roll, "on") == 0;
+        }
         double t0 = mps_wall_seconds();
         st = ops->configure(self, case_path, out, prefix, err);
         configured = 1;
+        /* the first save refuses a scene the solver cannot roll back, before READY */
+        if (!st && stats->rollback)
+            st = ops->save(self, err);
         if (st)
             goto fail;
         reply = proto_msg_make(PROTO_READY);
@@ -183,6 +236,10 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
             goto fail;
         }
         t0 = mps_wall_seconds();
+        if ((st = rollback(ops, self, &in, &last, stats, err)))
+            goto fail;
+        double t1 = mps_wall_seconds();
+        stats->rollback_seconds += t1 - t0;
         reply = proto_msg_make(PROTO_RESULT);
         st = ops->advance(self, &in, &reply, err);
         stats->compute_seconds += mps_wall_seconds() - t0;

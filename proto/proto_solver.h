@@ -28,14 +28,27 @@ struct proto_solver_ops {
                                struct mps_err *err);
     /* STOP: finish outputs; return the summary as a malloc'd JSON object. */
     char *(*finish)(void *self, enum mps_status st, const struct mps_err *err);
+    /* Optional, both or neither: implicit coupling (PROTOCOL.md 6, "Implicit
+     * coupling"). save keeps everything the next step's result depends on
+     * (outputs written so far included); restore returns to the last save,
+     * bit for bit. A solver with them declares caps=rollback in HELLO. With
+     * rollback=on in CONFIG the loop calls save after configure (so a scene
+     * the solver cannot roll back is refused before READY) and before every
+     * ADVANCE of iteration 0, and restore before every ADVANCE of
+     * iteration > 0. */
+    enum mps_status (*save)(void *self, struct mps_err *err);
+    enum mps_status (*restore)(void *self, struct mps_err *err);
 };
 
 /* Timing of the conversation, for the solver's summary. */
 struct proto_solver_stats {
     double setup_seconds;     /* inside configure/ready */
-    double compute_seconds;   /* inside advance */
+    double compute_seconds;   /* inside advance, save and restore */
     double wait_seconds;      /* waiting for the coupler */
-    long advances;
+    double rollback_seconds;  /* inside save and restore (part of compute_seconds) */
+    long advances;            /* every ADVANCE, repeated iterations included */
+    long repeats;             /* ADVANCEs with iteration > 0 */
+    int rollback;             /* CONFIG asked for rollback=on */
 };
 
 /* Runs the conversation on endpoint until STOP (MPS_OK), ABORT (MPS_EPEER),

@@ -91,3 +91,15 @@ void solid_load_probes_restart(struct solid_load_probes *lp)
     memset(lp->sum, 0, sizeof lp->sum);
     lp->time = 0.0;
 }
+
+void solid_load_probes_keep(const struct solid_load_probes *lp, struct solid_load_probes_mark *m)
+{
+    memcpy(m->sum, lp->sum, sizeof m->sum);
+    m->time = lp->time;
+}
+
+void solid_load_probes_back(struct solid_load_probes *lp, const struct solid_load_probes_mark *m)
+{
+    memcpy(lp->sum, m->sum, sizeof lp->sum);
+    lp->time = m->time;
+}

@@ -49,4 +49,14 @@ double solid_load_probes_value(const struct solid_load_probes *lp, const struct 
 /* A probe row was written: the means start again. */
 void solid_load_probes_restart(struct solid_load_probes *lp);
 
+/* The means so far, which a repeated coupling step (implicit coupling,
+ * PROTOCOL.md 6) returns to: kept by a model's save, put back by its restore
+ * (the loads themselves come again with the repeated step). */
+struct solid_load_probes_mark {
+    double sum[SOLID_MAX_PROBES];
+    double time;
+};
+void solid_load_probes_keep(const struct solid_load_probes *lp, struct solid_load_probes_mark *m);
+void solid_load_probes_back(struct solid_load_probes *lp, const struct solid_load_probes_mark *m);
+
 #endif

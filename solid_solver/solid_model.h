@@ -76,6 +76,15 @@ struct solid_model_ops {
     /* Extra summary members (phase times, counters) into an open JSON object. */
     void (*summary)(const void *self, struct mps_json *j);
     void (*destroy)(void **self);
+    /* Optional, both or neither (NULL: the model cannot roll back). For
+     * implicit coupling, which repeats a coupling step from its start: save
+     * keeps every part of the state that advance reads (particles, rotations,
+     * damping history, time and step counters); restore returns to the last
+     * save, so that the same loads then give the same state bit for bit.
+     * save fails with MPS_EINPUT, saying why, for a scene the model cannot
+     * roll back. */
+    enum mps_status (*save)(void *self, struct mps_err *err);
+    enum mps_status (*restore)(void *self, struct mps_err *err);
 };
 
 /* The models compiled in, by name; NULL if unknown. */

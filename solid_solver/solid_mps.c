@@ -277,6 +277,7 @@ void solid_mps_destroy(struct solid_mps **sp)
     free(s->bbr);
     free(s->vold);
     free(s->wold);
+    mps_particles_ckpt_free(&s->ckpt);
     solid_iface_cache_free(&s->iface);
     free(s);
     *sp = NULL;
@@ -599,6 +600,35 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_close(j);
 }
 
+/* The damping history (vold, wold) is rewritten at the start of every step
+ * and the loads by set_loads, so the particle fields, time and steps are the
+ * whole state. Fracture changes bonds, surface and contact lists, and the
+ * interface's size; rolling those back is not done. */
+static enum mps_status op_save(void *self, struct mps_err *err)
+{
+    struct solid_mps *s = self;
+    if (s->frac)
+        return mps_err_set(err, MPS_EINPUT,
+                           "solid: fracture or contact (solid.eps_max, solid.contact) cannot be "
+                           "rolled back: implicit coupling (coupling.scheme: implicit) needs "
+                           "them off");
+    s->ckpt_time = s->time;
+    s->ckpt_steps = s->steps;
+    solid_load_probes_keep(&s->loadprobes, &s->ckpt_loadprobes);
+    return mps_particles_save(&s->ps, &s->ckpt, err);
+}
+
+static enum mps_status op_restore(void *self, struct mps_err *err)
+{
+    struct solid_mps *s = self;
+    if (!s->ckpt.nfields)
+        return mps_err_set(err, MPS_EINPUT, "solid: restore without a save");
+    s->time = s->ckpt_time;
+    s->steps = s->ckpt_steps;
+    solid_load_probes_back(&s->loadprobes, &s->ckpt_loadprobes);
+    return mps_particles_restore(&s->ps, &s->ckpt, err);
+}
+
 static void op_destroy(void **self)
 {
     struct solid_mps *s = *self;
@@ -620,4 +650,6 @@ const struct solid_model_ops solid_mps_ops = {
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
+    .save = op_save,
+    .restore = op_restore,
 };

@@ -30,6 +30,7 @@ struct peer {
     double max_ratio;      /* largest sub-step / stable step seen */
     struct proto_solver_stats stats;
     double wall0;
+    int saved_snapshots;   /* snapshots written at the last save (rollback) */
 };
 
 static enum mps_status snapshot(struct peer *p, double t, long step, struct mps_err *err)
@@ -145,6 +146,25 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
     return st;
 }
 
+/* Implicit coupling (proto_solver.h): the model's state, and the snapshot
+ * series, which a repeated step must write again under the same names. */
+static enum mps_status save(void *self, struct mps_err *err)
+{
+    struct peer *p = self;
+    if (!p->ops->save)
+        return mps_err_set(err, MPS_EINPUT, "solid model %s cannot roll back a step",
+                           p->ops->name);
+    p->saved_snapshots = mps_h5_count(p->h5);
+    return p->ops->save(p->model, err);
+}
+
+static enum mps_status restore(void *self, struct mps_err *err)
+{
+    struct peer *p = self;
+    enum mps_status st = p->ops->restore(p->model, err);
+    return st ? st : mps_h5_rewind(p->h5, p->saved_snapshots, err);
+}
+
 static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const struct mps_err *err)
 {
     struct mps_json j;
@@ -167,7 +187,9 @@ static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const str
     mps_json_num(&j, "compute_seconds", p->stats.compute_seconds);
     mps_json_num(&j, "wait_seconds", p->stats.wait_seconds);
     mps_json_num(&j, "output_seconds", p->t_output);
-    mps_json_int(&j, "coupling_steps", p->stats.advances);
+    mps_json_int(&j, "coupling_steps", p->stats.advances - p->stats.repeats);
+    mps_json_int(&j, "advances", p->stats.advances); /* repeated iterations included */
+    mps_json_num(&j, "rollback_seconds", p->stats.rollback_seconds);
     mps_json_int(&j, "substeps", p->substeps);
     mps_json_num(&j, "substeps_per_coupling_step",
                  p->stats.advances ? (double)p->substeps / p->stats.advances : 0.0);
@@ -205,8 +227,10 @@ int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int 
 {
     struct peer p = {.ops = ops};
     p.wall0 = mps_wall_seconds();
+    /* every model of this program can roll back (a scene that cannot is
+     * refused by its save) */
     struct proto_solver_ops pops = {"solid", ops ? ops->name : "case", configure, ready, advance,
-                                    finish};
+                                    finish, save, restore};
     struct mps_err err = {0};
     enum mps_status st =
         proto_solver_run(endpoint, &pops, &p, hello_timeout_ms, stop_flag, &p.stats, &err);

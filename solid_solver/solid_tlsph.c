@@ -340,6 +340,7 @@ void solid_tlsph_destroy(struct solid_tlsph **sp)
         return;
     struct solid_tlsph *s = *sp;
     mps_particles_free(&s->ps);
+    mps_particles_ckpt_free(&s->ckpt);
     solid_load_probes_free(&s->loadprobes);
     free(s->pstart);
     free(s->pj);
@@ -716,6 +717,28 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_close(j);
 }
 
+static enum mps_status op_save(void *self, struct mps_err *err)
+{
+    struct solid_tlsph *s = self;
+    s->ckpt_vmax = s->vmax;
+    s->ckpt_time = s->time;
+    s->ckpt_steps = s->steps;
+    solid_load_probes_keep(&s->loadprobes, &s->ckpt_loadprobes);
+    return mps_particles_save(&s->ps, &s->ckpt, err);
+}
+
+static enum mps_status op_restore(void *self, struct mps_err *err)
+{
+    struct solid_tlsph *s = self;
+    if (!s->ckpt.nfields)
+        return mps_err_set(err, MPS_EINPUT, "solid: restore without a save");
+    s->vmax = s->ckpt_vmax;
+    s->time = s->ckpt_time;
+    s->steps = s->ckpt_steps;
+    solid_load_probes_back(&s->loadprobes, &s->ckpt_loadprobes);
+    return mps_particles_restore(&s->ps, &s->ckpt, err);
+}
+
 static void op_destroy(void **self)
 {
     struct solid_tlsph *s = *self;
@@ -737,4 +760,6 @@ const struct solid_model_ops solid_tlsph_ops = {
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
+    .save = op_save,
+    .restore = op_restore,
 };

@@ -1,4 +1,4 @@
-"""The coupling protocol (proto/PROTOCOL.md, version 1) in pure Python.
+"""The coupling protocol (proto/PROTOCOL.md, version 2) in pure Python.
 
 Written from PROTOCOL.md alone, to show that a solver needs nothing but numpy
 and pyzmq to talk to the coupler. Codec: encode(Message) -> list of frames
@@ -30,7 +30,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-VERSION = 1
+VERSION = 2
 DIM = 2
 HEADER = struct.Struct("<4sHHIHHqiiddQII16x")  # 80 bytes, PROTOCOL.md section 3
 MAGIC = b"MPSC"
@@ -342,6 +342,39 @@ def decode(frames: Sequence, dim: int = DIM) -> Message:
             _fail(m, f"text is not valid UTF-8 at byte {e.start}")
     _check(m, dim)
     return m
+
+
+def capabilities(hello_text: str) -> set:
+    """The capability names a HELLO declares (PROTOCOL.md 4: caps=a,b; absent means none)."""
+    caps = _kv(hello_text or "", " ").get("caps", "")
+    return {c for c in caps.split(",") if c}
+
+
+class Rollback:
+    """The solver's side of implicit coupling (PROTOCOL.md 6): call check()
+    with every ADVANCE before stepping. It says whether the step starts
+    (iteration 0: keep your state now) or repeats the previous one
+    (iteration > 0: return to the kept state), and raises ProtocolError for an
+    ADVANCE that may not come (a repeat without rollback=on in CONFIG, or
+    one that is not the previous step's next iteration)."""
+
+    def __init__(self, enabled: bool):
+        self.enabled = enabled
+        self.last = None   # (step, iteration, time, dt, n_sub) of the previous ADVANCE
+
+    def check(self, m: Message) -> str:
+        """'new' (iteration 0) or 'repeat'."""
+        prev, self.last = self.last, (m.step, m.iteration, m.time, m.dt, m.n_sub)
+        if m.iteration == 0:
+            return "new"
+        if not self.enabled:
+            raise ProtocolError(f"ADVANCE step {m.step} iteration {m.iteration}: a repeated "
+                                "step needs rollback=on in CONFIG")
+        if prev is None or (m.step, m.iteration - 1, m.time, m.dt, m.n_sub) != prev:
+            raise ProtocolError(f"ADVANCE step {m.step} iteration {m.iteration} at t = {m.time!r}, "
+                                f"dt = {m.dt!r}, n_sub {m.n_sub} does not repeat the previous "
+                                f"ADVANCE {prev}")
+        return "repeat"
 
 
 def error_status(text: str) -> tuple:

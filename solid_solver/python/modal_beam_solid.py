@@ -20,6 +20,11 @@ coupler's scene.xmf shows the plate with the fluid. Failures are reported to
 the coupler as ERROR (PROTOCOL.md 8). tests/coupler/conformance.py checks it
 against the protocol.
 
+Implicit coupling (PROTOCOL.md 6): it declares caps=rollback; with rollback=on
+in CONFIG it keeps (q, q') and the number of snapshots at the start of every
+step and returns to them when the coupler repeats the step (a repeated
+snapshot is written again under the same name and listed once in the index).
+
 usage: modal_beam_solid.py [--courant C] [--key FILE] --connect ENDPOINT
 """
 import json, math, os, sys, time
@@ -98,7 +103,7 @@ class Fail(Exception):
         super().__init__(f'{status}: {message}')
 
 
-CONFIG_KEYS = ('case', 'out', 'prefix', 'timeout_ms')
+CONFIG_KEYS = ('case', 'out', 'prefix', 'timeout_ms', 'rollback')
 
 
 class Snapshots:
@@ -192,9 +197,13 @@ def converse(sock, courant, t_wall):
     except (OSError, KeyError, TypeError, ValueError, IndexError, yaml.YAMLError) as e:
         raise Fail('input', f"case {conf['case']}: {type(e).__name__}: {e}") from e
     timeout = int(conf.get('timeout_ms', '1800000'))
+    if conf.get('rollback', 'off') not in ('on', 'off'):
+        raise Fail('input', f"CONFIG rollback={conf['rollback']}: must be on or off")
+    roll = mp.Rollback(conf.get('rollback') == 'on')
     step = 0
     snaps = Snapshots(conf['out'], conf['prefix'], config_text)
     snaps.write(0, 0.0, beam)
+    kept = (beam.q, beam.qd, len(snaps.grids))   # the state a repeated step starts from
 
     def state_msg(mtype, **kw):
         x, v = beam.state()
@@ -217,6 +226,12 @@ def converse(sock, courant, t_wall):
         if m.type != mp.Type.ADVANCE:
             raise Fail('protocol', f'expected ADVANCE, STOP or ABORT, got {mp.Type(m.type).name}')
         c0 = time.time()
+        if roll.check(m) == 'new':
+            kept = (beam.q, beam.qd, len(snaps.grids))
+        else:
+            beam.q, beam.qd, n_snaps = kept
+            del snaps.grids[n_snaps:]  # its snapshot is written again under the same name
+            step -= 1  # counts steps, not repeats
         beam.force = 0.0
         if m.payload == mp.Payload.LOADS and m.count:
             idx = m.id.astype(np.int64)
@@ -249,7 +264,8 @@ def main():
         print(f'modal_beam_solid: input: {e}', file=sys.stderr)
         ctx.term()
         return 2
-    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
+    mp.send(sock, mp.Message(mp.Type.HELLO,
+                             text=f'role=solid model=modal_beam pid={os.getpid()} caps=rollback'))
     try:
         code = converse(sock, courant, time.time())
     except (Fail, mp.ProtocolError, TimeoutError) as e:

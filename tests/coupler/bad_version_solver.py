@@ -1,6 +1,6 @@
 #!/usr/bin/python3
-"""A solver that speaks protocol version 2: the coupler must refuse it with a
-clear REJECT. Writes what it was told to REPORT (argv[1]) and exits 0 if it
+"""A solver that speaks protocol version 1 (before implicit coupling): the
+coupler must refuse it with a clear REJECT. Writes what it was told to REPORT (argv[1]) and exits 0 if it
 got a REJECT. Usage: bad_version_solver.py REPORT --connect ENDPOINT"""
 import os, struct, sys
 
@@ -13,9 +13,9 @@ endpoint = sys.argv[sys.argv.index('--connect') + 1]
 ctx = zmq.Context()
 sock = mpsproto.connect(ctx, endpoint)
 frames = mpsproto.encode(mpsproto.Message(type=mpsproto.Type.HELLO,
-                                          text=f"role=solid model=v2 pid={os.getpid()}"))
+                                          text=f"role=solid model=v1 pid={os.getpid()}"))
 header = bytearray(frames[0])
-struct.pack_into('<H', header, 4, 2)  # version 2
+struct.pack_into('<H', header, 4, 1)  # version 1
 sock.send_multipart([bytes(header)] + frames[1:])
 try:
     m = mpsproto.recv(sock, 20000)

@@ -18,18 +18,24 @@ add_test(NAME conformance_solid_python
 add_test(NAME conformance_toy_solid
          COMMAND ${CONFORMANCE} --solid "${CONFORMANCE_TOY}"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-foreach(case "step;result\\.echo" "abort;abort\\.exit" "silent;malformed\\.bad_magic\\.error"
-             "role;hello\\.text")
+add_test(NAME conformance_toy_solid_rollback
+         COMMAND ${CONFORMANCE} --solid "${CONFORMANCE_TOY} --rollback"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+foreach(case "step;;result\\.echo" "abort;;abort\\.exit" "silent;;malformed\\.bad_magic\\.error"
+             "role;;hello\\.text" "repeat;;iteration_unasked\\.error"
+             "norestore;--rollback;rollback\\.repeat")
   list(GET case 0 bug)
-  list(GET case 1 pattern)
+  list(GET case 1 flag)
+  list(GET case 2 pattern)
   add_test(NAME conformance_catches_bug_${bug}
            COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh "checks failed .*${pattern}"
-                   ${CONFORMANCE} --solid "${CONFORMANCE_TOY} --bug ${bug}"
+                   ${CONFORMANCE} --solid "${CONFORMANCE_TOY} ${flag} --bug ${bug}"
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 endforeach()
 
 set_tests_properties(conformance_solid_mps conformance_solid_tlsph conformance_solid_python
-                     conformance_toy_solid conformance_catches_bug_step
-                     conformance_catches_bug_abort conformance_catches_bug_silent
-                     conformance_catches_bug_role
+                     conformance_toy_solid conformance_toy_solid_rollback
+                     conformance_catches_bug_step conformance_catches_bug_abort
+                     conformance_catches_bug_silent conformance_catches_bug_role
+                     conformance_catches_bug_repeat conformance_catches_bug_norestore
                      PROPERTIES TIMEOUT 60 LABELS integration ENVIRONMENT OMP_NUM_THREADS=1)

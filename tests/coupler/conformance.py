@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Protocol conformance suite for solid solvers (proto/PROTOCOL.md, version 1).
+"""Protocol conformance suite for solid solvers (proto/PROTOCOL.md, version 2).
 
 Plays the coupler's side of the protocol against any solid solver command and
 checks that the solid does what PROTOCOL.md says, one named check at a time
@@ -14,13 +14,20 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
   reject          REJECT instead of CONFIG: no reply, exit non-zero (section 6)
   bad_magic       a message with magic "XXXX" instead of CONFIG      \\
   truncated       a 40-byte header instead of an ADVANCE               > ERROR
-  wrong_version   an ADVANCE of version 2                              > "protocol: ..."
+  wrong_version   an ADVANCE of version 1                              > "protocol: ..."
   unexpected      a second CONFIG where an ADVANCE is due             /  and exit 1
   unknown_id      LOADS naming an id the solid never sent      \  ERROR (any status: the
   duplicate_id    LOADS naming one id twice                    /  spec names none), exit
                                                                   status to match (section 8)
   unknown_key     CONFIG with a key the solver cannot know: ERROR "input: ...", exit 2
   timeout         CONFIG timeout_ms=1000, then silence: ERROR "timeout: ...", exit 1
+  iteration_unasked  an ADVANCE repeating step 0 (iteration 1) without rollback=on in
+                  CONFIG: ERROR "protocol: ...", exit 1
+  rollback        only for a solid that declares caps=rollback in HELLO: CONFIG with
+                  rollback=on, then step 0 with loads A, repeated with loads B, repeated
+                  with loads A (must give iteration 0's RESULT bit for bit: the state of the
+                  step's start was restored), step 1 with A twice (the same), then an
+                  iteration out of order: ERROR "protocol: ...", exit 1
   curve           on tcp with CURVE (section 10): the key file reaches the solver
                   as the coupler passes it (MPS_COUPLING_KEY); HELLO, READY, one
                   ADVANCE, STOP/BYE, exit 0, authenticated with the issued key
@@ -110,8 +117,8 @@ def wire_problems(frames):
     if len(h) < 8 or h[:4] != b'MPSC':
         return [f'magic {h[:4]!r}, expected b"MPSC"']
     version = struct.unpack_from('<H', h, 4)[0]
-    if version != 1:
-        return [f'version {version}, expected 1']
+    if version != 2:
+        return [f'version {version}, expected 2']
     if len(h) != HEADER.size:
         return [f'header frame {len(h)} bytes, expected 80']
     (_, _, mtype, flags, dim, payload, step, it, n_sub, t, dt, count, narrays,
@@ -373,6 +380,7 @@ class Suite:
         return f'case={self.case}\nout={s.out}\nprefix=solid\ntimeout_ms=60000\n' + extra
 
     def hello(self, s):
+        """Starts the solver and reads its HELLO; returns the HELLO text."""
         s.start()
         frames, el = s.recv(self.args.hello_timeout)
         if frames is None:
@@ -388,7 +396,7 @@ class Suite:
                 self.check(f'{s.name}.hello', False, '; '.join(bad) or
                            f'{name_of(f["type"])} instead of HELLO')
                 raise Stop
-            return
+            return frames[-1].decode('utf-8', 'replace') if f['flags'] & 1 else ''
         self.check('hello.arrives', True, f'after {el:.2f} s')
         if f:
             zero = [k for k in ('step', 'iteration', 'n_sub', 'time', 'dt', 'count', 'narrays',
@@ -400,7 +408,7 @@ class Suite:
             if zero:
                 bad.append(f'fields not zero: {", ".join(zero)}')
         self.check('hello.header', not bad,
-                   '; '.join(bad) or '80 bytes, MPSC, version 1, dim 2, HELLO, TEXT, other fields zero')
+                   '; '.join(bad) or '80 bytes, MPSC, version 2, dim 2, HELLO, TEXT, other fields zero')
         if bad:
             raise Stop
         text = frames[-1].decode('utf-8')
@@ -416,6 +424,10 @@ class Suite:
         pid = kv.get('pid', '')
         if not (pid.isascii() and pid.isdigit()):
             problems.append(f'pid={pid!r} not decimal')
+        caps = kv.get('caps')
+        if caps is not None and (not caps or any(not c for c in caps.split(','))):
+            problems.append(f'caps={caps!r}: expected names separated by commas (section 4)')
+        self.caps = mp.capabilities(text)
         self.check('hello.text', not problems, '; '.join(problems) or repr(text))
         if pid.isascii() and pid.isdigit():
             p = int(pid)
@@ -724,7 +736,7 @@ class Suite:
         self.hello(s)
         self.ready(s)
         frames = mp.encode(mp.Message(mp.Type.ADVANCE, step=0, time=0.0, dt=1e-6, n_sub=1))
-        frames[0] = frames[0][:4] + struct.pack('<H', 2) + frames[0][6:]
+        frames[0] = frames[0][:4] + struct.pack('<H', 1) + frames[0][6:]
         s.send(frames)
         self.expect_error(s, 'malformed.wrong_version', 'protocol', 1)
 
@@ -767,6 +779,86 @@ class Suite:
             raise Stop
         self.expect_error(s, 'timeout', 'timeout', 1)
 
+    def scenario_iteration_unasked(self, s):
+        """Section 6: a repeated step (iteration > 0) only after rollback=on."""
+        self.hello(s)
+        r = self.ready(s)
+        self.advance(s, 0, 0.0, self.args.dt, self.n_sub(r.dt), mp.Payload.NONE)
+        s.send(mp.Message(mp.Type.ADVANCE, step=0, iteration=1, time=0.0, dt=self.args.dt,
+                          n_sub=self.n_sub(r.dt)))
+        self.expect_error(s, 'iteration_unasked', 'protocol', 1)
+
+    def n_sub(self, dt_solid):
+        return max(1, math.ceil(self.args.dt / dt_solid * (1 - 1e-12)))
+
+    def scenario_rollback(self, s):
+        """Section 6, implicit coupling: a repeated step starts from the state the
+        step started from, so the same loads give the same RESULT bit for bit."""
+        text = self.hello(s)
+        if 'rollback' not in mp.capabilities(text):
+            print(f'INFO  rollback: the solid declares no caps=rollback ({text!r}): it cannot '
+                  'run under coupling.scheme: implicit; not checked')
+            return
+        r = self.ready(s, 'rollback=on\n')
+        self.check('rollback.config', True, 'READY after CONFIG rollback=on')
+        free = (r.surface == 1) & (r.fixed == 0)
+        ids = r.id[free]
+
+        def loads(fx):
+            return (ids, np.tile([fx, 0.0], (len(ids), 1)))
+
+        a, b = loads(self.args.force), loads(-3.0 * self.args.force)
+        dt, n = self.args.dt, self.n_sub(r.dt)
+        fl = mp.F_PROBES
+
+        def result(k, it, ld, flags=fl):
+            s.send(mp.Message(mp.Type.ADVANCE, payload=mp.Payload.LOADS, flags=flags, step=k,
+                              iteration=it, time=k * dt, dt=dt, n_sub=n,
+                              id=np.asarray(ld[0], np.int32), force=ld[1],
+                              pressure=np.zeros(len(ld[0]))))
+            frames, _ = s.recv(self.args.step_timeout)
+            bad = ['no RESULT'] if frames is None else wire_problems(frames)
+            f = fields(frames) if not bad else {}
+            if f and (f['type'] != 6 or f['step'] != k or f['iteration'] != it):
+                bad.append(f'{name_of(f["type"])} step {f["step"]} iteration {f["iteration"]}'
+                           + (f': {frames[-1].decode("utf-8", "replace")}' if f['flags'] & 1 else ''))
+            if bad:
+                self.check(f'rollback.step{k}.iteration{it}', False, '; '.join(bad))
+                raise Stop
+            return frames
+
+        def same(f1, f2):
+            """Bit for bit: every array frame and the header's time, dt and nprobes."""
+            h1, h2 = fields(f1), fields(f2)
+            keys = ('time', 'dt', 'count', 'nprobes')
+            diff = [k for k in keys if h1[k] != h2[k]]
+            diff += [f'frame {k}' for k in range(1, len(f1)) if bytes(f1[k]) != bytes(f2[k])]
+            return diff
+
+        # step 0 without PROBES, step 1 with: step 1's probe row holds the means
+        # over both steps (time-mean load probes, solid_loadprobe.h), so a
+        # solid that does not restore its means at a repeat shows in step 1
+        r0 = result(0, 0, a, 0)
+        r1 = result(0, 1, b, 0)
+        self.check('rollback.loads_matter', bool(same(r0, r1)),
+                   'loads B gave another RESULT than loads A in the same step' if same(r0, r1)
+                   else 'loads A and B gave the same RESULT: the repeat checks below prove nothing')
+        r2 = result(0, 2, a, 0)
+        d = same(r0, r2)
+        self.check('rollback.repeat', not d,
+                   'step 0 repeated with loads A after B: the RESULT of iteration 0 bit for bit'
+                   if not d else f'differs from iteration 0 in {", ".join(d)}: the state of the '
+                   'step\'s start was not restored')
+        r3 = result(1, 0, a, fl | mp.F_SNAPSHOT)
+        r4 = result(1, 1, a, fl | mp.F_SNAPSHOT)
+        d = same(r3, r4)
+        self.check('rollback.repeat_next_step', not d,
+                   'step 1 (from the accepted iteration 2 of step 0) repeated with the same loads: '
+                   'bit for bit' if not d else f'differs in {", ".join(d)}')
+        s.send(mp.Message(mp.Type.ADVANCE, payload=mp.Payload.NONE, step=1, iteration=3,
+                          time=dt, dt=dt, n_sub=n))
+        self.expect_error(s, 'rollback.out_of_order', 'protocol', 1)
+
     def scenario_curve(self, s):
         """Section 10: a whole short conversation over tcp with CURVE."""
         self.hello(s)
@@ -797,7 +889,7 @@ class Suite:
 
     SCENARIOS = ('run', 'abort', 'reject', 'bad_magic', 'truncated', 'wrong_version',
                  'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'timeout',
-                 'curve', 'curve_no_key')
+                 'iteration_unasked', 'rollback', 'curve', 'curve_no_key')
 
     def run(self):
         print(f'conformance: solid {" ".join(self.command)}, case {self.args.case}', flush=True)

@@ -2,14 +2,18 @@
 """A toy solid for the conformance suite (conformance.py): the first body of
 the case as free particles (no bonds: each particle obeys m x'' = f, clamped
 ones stay put), speaking PROTOCOL.md through mpsproto. As it is, it passes the
-suite, which shows the suite asks nothing beyond the protocol. Each --bug
-breaks one rule, so ctest can check that the suite catches it:
-  --bug step     RESULT echoes step + 1
-  --bug abort    ignores ABORT and waits for the next message
-  --bug silent   dies on a malformed message without sending ERROR
-  --bug role     says role=fluid in its HELLO
+suite, which shows the suite asks nothing beyond the protocol. By default it
+cannot repeat a step (no caps=rollback); --rollback makes it declare the
+capability and keep its state for implicit coupling. Each --bug breaks one
+rule, so ctest can check that the suite catches it:
+  --bug step       RESULT echoes step + 1
+  --bug abort      ignores ABORT and waits for the next message
+  --bug silent     dies on a malformed message without sending ERROR
+  --bug role       says role=fluid in its HELLO
+  --bug repeat     takes an ADVANCE of iteration > 0 as a new step, unasked
+  --bug norestore  (with --rollback) repeats a step from where the last one ended
 
-usage: conformance_toy_solid.py [--bug NAME] --connect ENDPOINT
+usage: conformance_toy_solid.py [--rollback] [--bug NAME] --connect ENDPOINT
 """
 import json, os, sys
 
@@ -23,6 +27,7 @@ import mpsproto as mp  # noqa: E402
 
 args = sys.argv[1:]
 BUG = args[args.index('--bug') + 1] if '--bug' in args else None
+ROLLBACK = '--rollback' in args
 
 
 class Fail(Exception):
@@ -51,7 +56,7 @@ def converse(sock):
     if cfg.type != mp.Type.CONFIG:
         raise Fail(f'protocol: expected CONFIG, got {mp.Type(cfg.type).name}')
     conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
-    unknown = set(conf) - {'case', 'out', 'prefix', 'timeout_ms'}
+    unknown = set(conf) - {'case', 'out', 'prefix', 'timeout_ms'} - ({'rollback'} if ROLLBACK else set())
     if unknown:
         raise Fail(f"input: CONFIG key '{sorted(unknown)[0]}' unknown")
     with open(conf['case']) as f:
@@ -67,6 +72,8 @@ def converse(sock):
         return mp.Message(mtype, payload=mp.Payload.STATE, id=ids, x=x, v=v, surface=surface,
                           fixed=fixed, dt=dt_stable, **kw)
 
+    roll = mp.Rollback(conf.get('rollback') == 'on')
+    kept = (x.copy(), v.copy())
     snapshot(0)
     mp.send(sock, state(mp.Type.READY))
     timeout = int(conf.get('timeout_ms', 1800000))
@@ -82,6 +89,12 @@ def converse(sock):
             return 0
         if m.type != mp.Type.ADVANCE:
             raise Fail(f'protocol: expected ADVANCE, STOP or ABORT, got {mp.Type(m.type).name}')
+        if BUG == 'repeat' and m.iteration > 0:
+            pass  # the bug: a repeat taken as a new step
+        elif roll.check(m) == 'new':
+            kept = (x.copy(), v.copy())
+        elif BUG != 'norestore':
+            x[:], v[:] = kept
         force[:] = 0.0
         if m.payload == mp.Payload.LOADS and m.count:
             if m.id.max() >= n or len(np.unique(m.id)) != m.count:
@@ -102,7 +115,8 @@ def main():
     ctx = zmq.Context()
     sock = mp.connect(ctx, args[args.index('--connect') + 1])
     role = 'fluid' if BUG == 'role' else 'solid'
-    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role={role} model=toy pid={os.getpid()}'))
+    caps = ' caps=rollback' if ROLLBACK else ''
+    mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role={role} model=toy pid={os.getpid()}{caps}'))
     try:
         code = converse(sock)
     except (Fail, mp.ProtocolError, TimeoutError) as e:

@@ -2,11 +2,16 @@
  * case as a rigid lattice of particles moving on a prescribed path
  *   x(t) = x0 + A sin(2 pi f t),
  * that reports the total fluid force it receives as probes (plate_fx,
- * plate_fy: the force of the last step; plate_dx), followed by the case's
- * solid.probes through the scene-level probe code every solid model uses
- * (solid_scene.h, solid_loadprobe.h: force_x, force_y, moment as means over
- * each probe interval). It speaks the protocol through proto_solver like
- * the real solids do.
+ * plate_fy: the force of the last step; plate_dx; tip_EI: the quasi-static
+ * tip deflection those loads would give a cantilever clamped at the top of
+ * the case's first clamp, times its E I (N m^2 per metre):
+ * sum_k f_x,k a_k^2 (3 L - a_k) / 6, a_k the particle's height above the
+ * clamp, L the free length (Euler-Bernoulli; docs/hard_cases.md, the stiff
+ * plate against the rigid limit)), followed by the case's solid.probes
+ * through the scene-level probe code every solid model uses (solid_scene.h,
+ * solid_loadprobe.h: force_x, force_y, moment as means over each probe
+ * interval). It speaks the protocol through proto_solver like the real
+ * solids do.
  *   fake_solid [--amplitude A] [--frequency F] [--fail-at T] [--version V]
  *              --connect ENDPOINT
  * --fail-at T makes it crash (abort) at time T, for the coupler's failure
@@ -14,7 +19,10 @@
  * before it connects, --hang-in ready after CONFIG (before READY). With
  * --hang-mark FILE it writes the wall-clock second (CLOCK_REALTIME, as
  * Python's time.time()) at which it stops answering into FILE, so a test
- * measures the coupler's deadline from there. */
+ * measures the coupler's deadline from there. It can repeat a step (implicit
+ * coupling: its state is a function of time, so there is nothing to keep);
+ * --no-rollback makes it a solver that cannot (no caps=rollback in HELLO),
+ * which the coupler must refuse when implicit coupling is asked. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,7 +40,7 @@
 #include "solid_loadprobe.h"
 #include "solid_scene.h"
 
-#define FIXED_PROBES 3
+#define FIXED_PROBES 4
 
 struct fake {
     double amp, freq, fail_at, hang_at;
@@ -44,6 +52,8 @@ struct fake {
     double (*x0)[2], (*x)[2], (*v)[2];
     unsigned char *surface, *fixed;
     double force[2];
+    double tip_ei;             /* see the header */
+    double yc, len;            /* clamp top, free length (m) */
     double t;
     /* the case's probes */
     struct solid_scene scene;
@@ -102,7 +112,13 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     s->dp = mps_case_double(c, "dp");
     double b[4] = {mps_case_double(c, "solid.bodies.0.x0"), mps_case_double(c, "solid.bodies.0.y0"),
                    mps_case_double(c, "solid.bodies.0.x1"), mps_case_double(c, "solid.bodies.0.y1")};
+    /* the clamp's top: the top of the highest row whose centres it covers */
+    double cy1 = mps_case_count(c, "solid.clamps") ? mps_case_double(c, "solid.clamps.0.y1") : b[1];
     mps_case_destroy(&c);
+    s->yc = b[1];
+    for (long j = 0; b[1] + (j + 0.5) * s->dp <= cy1; j++)
+        s->yc = b[1] + (j + 1.0) * s->dp;
+    s->len = b[3] - s->yc;
     long nx = (long)floor((b[2] - b[0]) / s->dp + 1e-6), ny = (long)floor((b[3] - b[1]) / s->dp + 1e-6);
     s->n = (size_t)(nx * ny);
     s->id = calloc(s->n, sizeof *s->id);
@@ -126,7 +142,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     place(s, 0.0);
     solid_probes_locate(&s->scene, s->n, (const double(*)[2])s->x0, s->probe_n, s->probe_i);
     solid_load_probes_init(&s->loadprobes, &s->scene);
-    const char *names[FIXED_PROBES + SOLID_MAX_PROBES] = {"plate_fx", "plate_fy", "plate_dx"};
+    const char *names[FIXED_PROBES + SOLID_MAX_PROBES] = {"plate_fx", "plate_fy", "plate_dx",
+                                                               "tip_EI"};
     for (int q = 0; q < s->scene.nprobes; q++)
         names[FIXED_PROBES + q] = s->scene.probes[q].name;
     proto_join_names(names, FIXED_PROBES + s->scene.nprobes, s->names, sizeof s->names);
@@ -165,7 +182,7 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
         abort(); /* a crash, as a buggy solver would */
     if (s->hang_at >= 0.0 && in->time >= s->hang_at)
         hang(s);
-    s->force[0] = s->force[1] = 0.0;
+    s->force[0] = s->force[1] = s->tip_ei = 0.0;
     struct solid_loads loads = {0};
     if (in->payload == PROTO_LOADS) {
         for (size_t k = 0; k < in->count; k++) {
@@ -174,6 +191,11 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
                                    in->id[k]);
             s->force[0] += in->force[k][0];
             s->force[1] += in->force[k][1];
+            int i = in->id[k];
+            if (i >= 0 && (size_t)i < s->n) {
+                double a = fmin(fmax(s->x0[i][1] - s->yc, 0.0), s->len);
+                s->tip_ei += in->force[k][0] * a * a * (3.0 * s->len - a) / 6.0;
+            }
         }
         loads = (struct solid_loads){in->count, in->id, in->pressure, in->force};
     }
@@ -189,6 +211,7 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
         s->probes[0] = s->force[0];
         s->probes[1] = s->force[1];
         s->probes[2] = s->x[0][0] - s->x0[0][0];
+        s->probes[3] = s->tip_ei;
         for (int k = 0; k < s->scene.nprobes; k++)
             s->probes[FIXED_PROBES + k] = solid_probe_value(
                 &s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
@@ -197,6 +220,24 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
         reply->nprobes = FIXED_PROBES + s->scene.nprobes;
         reply->probes = s->probes;
     }
+    return MPS_OK;
+}
+
+/* The path is a function of time: a repeated step needs only the load
+ * probes' means restored. */
+static struct solid_load_probes_mark kept_loadprobes;
+
+static enum mps_status save(void *self, struct mps_err *err)
+{
+    solid_load_probes_keep(&((struct fake *)self)->loadprobes, &kept_loadprobes);
+    (void)err;
+    return MPS_OK;
+}
+
+static enum mps_status restore(void *self, struct mps_err *err)
+{
+    solid_load_probes_back(&((struct fake *)self)->loadprobes, &kept_loadprobes);
+    (void)err;
     return MPS_OK;
 }
 
@@ -218,6 +259,10 @@ static volatile int stop_flag = 0;
 int main(int argc, char **argv)
 {
     struct fake s = {.amp = 0.0, .freq = 1.0, .fail_at = -1.0, .hang_at = -1.0};
+    int rollback = 1;
+    for (int i = 1; i < argc; i++)
+        if (!strcmp(argv[i], "--no-rollback"))
+            rollback = 0;
     for (int i = 1; i + 1 < argc; i++) {
         if (!strcmp(argv[i], "--amplitude"))
             s.amp = atof(argv[++i]);
@@ -241,8 +286,12 @@ int main(int argc, char **argv)
     }
     if (s.hang_in && !strcmp(s.hang_in, "hello"))
         hang(&s);
-    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready, advance, finish};
-    enum mps_status st = proto_solver_run(endpoint, &ops, &s, hello_ms, &stop_flag, &stats, &err);
+    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready,
+                                                advance, finish,  save,      restore};
+    static const struct proto_solver_ops ops_fixed = {"solid", "fake", configure,
+                                                      ready,   advance, finish, NULL, NULL};
+    enum mps_status st = proto_solver_run(endpoint, rollback ? &ops : &ops_fixed, &s, hello_ms,
+                                          &stop_flag, &stats, &err);
     if (st)
         fprintf(stderr, "fake_solid: %s: %s\n", mps_status_name(st), err.msg);
     free(s.id);

@@ -104,6 +104,13 @@ SHORT = [
     ('docs/security.md', r'^(build/fuzz/fuzz_\w+) -runs=\d+ ', r'test ! -x \g<1> || \g<1> -runs=5000 ',
      'each fuzzer for 5000 inputs (millions: 15 minutes); skipped where the build has no '
      'fuzzers (MPS_FUZZ=1 and clang)'),
+    ('docs/hard_cases.md', r'^/usr/bin/python3 bench/hard_cases\.py$', r'\g<0> --quick --report-only',
+     'the report from the runs there are (none in the copy: rows "not run"); the runs take '
+     'hours'),
+    ('docs/hard_cases.md', r'^for i in 1 2 3 4 5; do for s in implicit explicit', 'for i in 1; do for s in implicit explicit',
+     'one pair of the paired timing, not five'),
+    ('docs/hard_cases.md', r'^OMP_NUM_THREADS=1 build/bin/coupler .*std_explicit_1thread_60 .*$',
+     r'\g<0> --set end_time=0.3', 'the one-thread plate to 0.3 s, not 2'),
     ('docs/solid_models.md', r'^\s*bench/solid_cantilever\.py --bin build/bin/solid_solver.*\\\n.*$',
      'true', 'the cantilever table of each model: minutes'),
     ('docs/testing.md', r'^nice -n 10 /usr/bin/python3 tests/mutation/run\.py .*$',

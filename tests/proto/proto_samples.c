@@ -23,7 +23,7 @@ struct sample {
 static const struct sample samples[] = {
     {"hello", PROTO_HELLO, PROTO_NONE, 0, 0, 0, 0, 0, 0, 0, "role=fluid model=mps pid=4242"},
     {"reject", PROTO_REJECT, PROTO_NONE, 0, 0, 0, 0, 0, 0, 0,
-     "protocol version 2 received, this build speaks version 1"},
+     "protocol version 1 received, this build speaks version 2"},
     {"config", PROTO_CONFIG, PROTO_NONE, 0, 0, 0, 0, 0, 0, 0,
      "case=/tmp/run/case.resolved.yml\nout=/tmp/run/out dir\nprefix=fluid\ntimeout_ms=1260000\n"},
     {"ready_fluid", PROTO_READY, PROTO_NONE, 0, 0, 0, 0, 0x1p-13, 0, 2, "p_gauge,h_front"},

@@ -199,13 +199,13 @@ static void test_header_rejections(void)
     c.data[0][0] = 'X';
     EXPECT_REJECT(&c, "bad magic \"XPSC\"", "magic");
     FRESH();
-    put16(&c, 4, 2);
-    EXPECT_REJECT(&c, "protocol version 2 received, this build speaks version 1", "version");
+    put16(&c, 4, 1);
+    EXPECT_REJECT(&c, "protocol version 1 received, this build speaks version 2", "version");
     FRESH();
-    put16(&c, 4, 2);
+    put16(&c, 4, 3);
     memcpy(longer, c.data[0], PROTO_HEADER_LEN);
-    wire_set(&c, 0, longer, sizeof longer); /* a v2 header may be longer: version wins */
-    EXPECT_REJECT(&c, "version 2 received", "version before length");
+    wire_set(&c, 0, longer, sizeof longer); /* a v3 header may be longer: version wins */
+    EXPECT_REJECT(&c, "version 3 received", "version before length");
     FRESH();
     c.len[0] = 64;
     EXPECT_REJECT(&c, "header frame is 64 bytes, expected 80", "header length");
@@ -400,8 +400,8 @@ static void test_text_rejections(void)
     /* a REJECT from a peer of another version still says why */
     wire_sample(&c, "reject");
     put16(&c, 4, 7);
-    EXPECT_REJECT(&c, "version 7 received, this build speaks version 1 (the peer's REJECT "
-                      "says: protocol version 2 received",
+    EXPECT_REJECT(&c, "version 7 received, this build speaks version 2 (the peer's REJECT "
+                      "says: protocol version 1 received",
                   "foreign REJECT");
     wire_free(&c);
 }

@@ -218,13 +218,13 @@ static void test_wrong_version_hello(void)
     CHECK(proto_msg_encode(&m, &fr, &e) == MPS_OK);
     unsigned char h2[PROTO_HEADER_LEN];
     memcpy(h2, fr.f[0].data, sizeof h2);
-    h2[4] = 2; /* a version-2 solver */
+    h2[4] = 1; /* a version-1 solver (before implicit coupling) */
     fr.f[0].data = h2;
     send_raw(solver, fr.f, fr.n);
     proto_frames_clear(&fr);
 
     CHECK(proto_link_recv(coupler, &in, 5000, &e) == MPS_EPROTO);
-    CHECK(strstr(e.msg, "protocol version 2 received, this build speaks version 1") != NULL);
+    CHECK(strstr(e.msg, "protocol version 1 received, this build speaks version 2") != NULL);
     printf("  wrong-version HELLO: %s\n", e.msg);
 
     /* the coupler turns it away with the reason; the solver reads it */
@@ -234,7 +234,7 @@ static void test_wrong_version_hello(void)
     rej.text = reason;
     CHECK(proto_link_send(coupler, &rej, &e) == MPS_OK);
     CHECK(proto_link_recv(solver, &in, 5000, &e) == MPS_OK);
-    CHECK(in.type == PROTO_REJECT && in.text && strstr(in.text, "version 2 received"));
+    CHECK(in.type == PROTO_REJECT && in.text && strstr(in.text, "version 1 received"));
     proto_msg_clear(&in);
 
     /* a message of too many frames is dropped whole; the next one is fine */

@@ -36,7 +36,7 @@ from mpsproto import F_PROBES, F_SNAPSHOT, Message, Payload, Type  # noqa: E402
 SAMPLES = [
     ("hello", Type.HELLO, Payload.NONE, 0, 0, 0, 0.0, 0.0, 0, 0, "role=fluid model=mps pid=4242"),
     ("reject", Type.REJECT, Payload.NONE, 0, 0, 0, 0.0, 0.0, 0, 0,
-     "protocol version 2 received, this build speaks version 1"),
+     "protocol version 1 received, this build speaks version 2"),
     ("config", Type.CONFIG, Payload.NONE, 0, 0, 0, 0.0, 0.0, 0, 0,
      "case=/tmp/run/case.resolved.yml\nout=/tmp/run/out dir\nprefix=fluid\ntimeout_ms=1260000\n"),
     ("ready_fluid", Type.READY, Payload.NONE, 0, 0, 0, 0.0, 2.0**-13, 0, 2, "p_gauge,h_front"),
@@ -166,8 +166,8 @@ def main():
             return fn
 
         bad = {
-            "version": (corrupt("hello", header_field("<H", 4, 2)),
-                        "protocol version 2 received, this build speaks version 1"),
+            "version": (corrupt("hello", header_field("<H", 4, 1)),
+                        "protocol version 1 received, this build speaks version 2"),
             "magic": (corrupt("hello", lambda f: f[0].__setitem__(0, ord("X"))), "bad magic"),
             "type": (corrupt("stop", header_field("<H", 6, 11)), "unknown message type 11"),
             "payload": (corrupt("stop", header_field("<H", 14, 3)), "unknown payload kind 3"),

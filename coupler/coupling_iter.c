@@ -1,0 +1,186 @@
+#include "coupling_iter.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+size_t coupling_iter_len(const struct coupling_iter *it)
+{
+    return MPS_DIM * it->n;
+}
+
+enum mps_status coupling_iter_init(struct coupling_iter *it, const struct proto_msg *ready,
+                                   double tol, double atol, struct mps_err *err)
+{
+    memset(it, 0, sizeof *it);
+    const size_t n = ready->count, m = n ? n : 1;
+    it->tol = tol;
+    it->atol = atol;
+    it->id = malloc(m * sizeof *it->id);
+    it->surface = malloc(m);
+    it->fixed = malloc(m);
+    it->x0 = malloc(m * sizeof *it->x0);
+    it->x_start = malloc(m * sizeof *it->x_start);
+    it->x_prev = malloc(m * sizeof *it->x_prev);
+    it->x_send = malloc(m * sizeof *it->x_send);
+    it->v_send = malloc(m * sizeof *it->v_send);
+    it->in = malloc(m * sizeof *it->in * MPS_DIM);
+    it->out = malloc(m * sizeof *it->out * MPS_DIM);
+    it->next = malloc(m * sizeof *it->next * MPS_DIM);
+    it->best = malloc(m * sizeof *it->best * MPS_DIM);
+    if (!it->id || !it->surface || !it->fixed || !it->x0 || !it->x_start || !it->x_prev ||
+        !it->x_send || !it->v_send || !it->in || !it->out || !it->next || !it->best) {
+        coupling_iter_free(it);
+        return mps_err_set(err, MPS_ENOMEM, "implicit coupling: out of memory for %zu particles",
+                           n);
+    }
+    it->n = n;
+    if (n) {
+        memcpy(it->id, ready->id, n * sizeof *it->id);
+        memcpy(it->surface, ready->surface, n);
+        memcpy(it->fixed, ready->fixed, n);
+        memcpy(it->x0, ready->x, n * sizeof *it->x0);
+    }
+    return MPS_OK;
+}
+
+void coupling_iter_free(struct coupling_iter *it)
+{
+    free(it->id);
+    free(it->surface);
+    free(it->fixed);
+    free(it->x0);
+    free(it->x_start);
+    free(it->x_prev);
+    free(it->x_send);
+    free(it->v_send);
+    free(it->in);
+    free(it->out);
+    free(it->next);
+    free(it->best);
+    memset(it, 0, sizeof *it);
+}
+
+/* A STATE from the solid must be READY's interface, in READY's order. */
+static enum mps_status same_interface(const struct coupling_iter *it, const struct proto_msg *m,
+                                      struct mps_err *err)
+{
+    if (m->payload != PROTO_STATE || m->count != it->n)
+        return mps_err_set(err, MPS_EINPUT,
+                           "implicit coupling: the solid's interface has %zu particles, it had "
+                           "%zu at READY: an interface that changes (fracture) cannot be "
+                           "iterated on",
+                           m->count, it->n);
+    for (size_t k = 0; k < it->n; k++)
+        if (m->id[k] != it->id[k])
+            return mps_err_set(err, MPS_EINPUT,
+                               "implicit coupling: the solid's interface lists id %d at position "
+                               "%zu, READY had id %d there: the implicit coupling needs the "
+                               "interface in one order",
+                               m->id[k], k, it->id[k]);
+    return MPS_OK;
+}
+
+/* Positions vec into send, with the step's mean velocity (header). */
+static void unpack(struct coupling_iter *it, const double *vec, struct proto_msg *send)
+{
+    for (size_t k = 0; k < it->n; k++)
+        for (int a = 0; a < MPS_DIM; a++) {
+            it->x_send[k][a] = vec[MPS_DIM * k + a];
+            it->v_send[k][a] = (vec[MPS_DIM * k + a] - it->x_start[k][a]) / it->dt;
+        }
+    *send = proto_msg_make(PROTO_ADVANCE);
+    send->payload = PROTO_STATE;
+    send->count = it->n;
+    send->id = it->id;
+    send->x = (const double(*)[MPS_DIM])it->x_send;
+    send->v = (const double(*)[MPS_DIM])it->v_send;
+    send->surface = it->surface;
+    send->fixed = it->fixed;
+}
+
+enum mps_status coupling_iter_start(struct coupling_iter *it, const struct proto_msg *now,
+                                    double dt, struct proto_msg *send, struct mps_err *err)
+{
+    enum mps_status st = same_interface(it, now, err);
+    if (st)
+        return st;
+    if (!(dt > 0.0))
+        return mps_err_set(err, MPS_EINPUT, "implicit coupling: step %g s", dt);
+    it->dt = dt;
+    memcpy(it->x_start, now->x, it->n * sizeof *it->x_start);
+    /* x_n + (x_n - x_(n-1)) dt_n / dt_(n-1); the first step x_0 + v_0 dt.
+     * Clamped particles stay put. */
+    const double f = it->dt_prev > 0.0 ? dt / it->dt_prev : 0.0;
+    for (size_t k = 0; k < it->n; k++)
+        for (int a = 0; a < MPS_DIM; a++) {
+            double step = it->fixed[k] ? 0.0
+                        : f > 0.0  ? f * (now->x[k][a] - it->x_prev[k][a])
+                                   : dt * now->v[k][a];
+            it->in[MPS_DIM * k + a] = now->x[k][a] + step;
+        }
+    memcpy(it->x_prev, now->x, it->n * sizeof *it->x_prev);
+    it->dt_prev = dt;
+    it->best_change = INFINITY;
+    it->best_k = it->last_k = -1;
+    unpack(it, it->in, send);
+    return MPS_OK;
+}
+
+enum mps_status coupling_iter_result(struct coupling_iter *it, const struct proto_msg *res,
+                                     int *converged, struct mps_err *err)
+{
+    enum mps_status st = same_interface(it, res, err);
+    if (st)
+        return st;
+    double ch = 0.0, disp = 0.0, inc = 0.0;
+    for (size_t k = 0; k < it->n; k++)
+        for (int a = 0; a < MPS_DIM; a++) {
+            size_t q = MPS_DIM * k + (size_t)a;
+            it->out[q] = res->x[k][a];
+            double d = it->out[q] - it->in[q], u = res->x[k][a] - it->x0[k][a];
+            double s = res->x[k][a] - it->x_start[k][a];
+            ch += d * d;
+            disp += u * u;
+            inc += s * s;
+        }
+    double inv = it->n ? 1.0 / (double)it->n : 0.0;
+    it->change = sqrt(ch * inv);
+    it->displacement = sqrt(disp * inv);
+    it->increment = sqrt(inc * inv);
+    *converged = it->change <= it->tol * it->increment + it->atol * it->dt;
+    it->last_k++;
+    if (it->change <= it->best_change) { /* ties: the later, already the solvers' state */
+        it->best_change = it->change;
+        it->best_k = it->last_k;
+        memcpy(it->best, it->in, coupling_iter_len(it) * sizeof *it->best);
+    }
+    return MPS_OK;
+}
+
+int coupling_iter_best(struct coupling_iter *it, struct proto_msg *send)
+{
+    if (it->best_k < 0 || it->best_k == it->last_k)
+        return 0;
+    memcpy(it->in, it->best, coupling_iter_len(it) * sizeof *it->in);
+    unpack(it, it->in, send);
+    return 1;
+}
+
+enum mps_status coupling_iter_relax(struct coupling_iter *it, struct coupling_accel *a,
+                                    struct proto_msg *send, struct mps_err *err)
+{
+    enum mps_status st = coupling_accel_next(a, it->in, it->out, it->next, err);
+    if (st)
+        return st;
+    /* clamped particles stay where the solid has them, whatever the scheme */
+    for (size_t k = 0; k < it->n; k++)
+        if (it->fixed[k])
+            for (int q = 0; q < MPS_DIM; q++)
+                it->next[MPS_DIM * k + q] = it->out[MPS_DIM * k + q];
+    double *t = it->in;
+    it->in = it->next;
+    it->next = t;
+    unpack(it, it->in, send);
+    return MPS_OK;
+}

@@ -1,0 +1,104 @@
+# Implicit coupling (issue 18): the solvers' rollback, the acceleration
+# schemes, and short runs of the hard cases (docs/hard_cases.md).
+
+# The fluid repeats a step bit for bit from its checkpoint (two threads: the
+# OpenMP reductions must not make a repeat differ).
+add_test(NAME fluid_rollback
+         COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/fluid_rollback.py ${CMAKE_BINARY_DIR}/bin
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_rollback PROPERTIES TIMEOUT 120 LABELS integration
+                     ENVIRONMENT "OMP_NUM_THREADS=2;OMP_WAIT_POLICY=passive")
+
+# Aitken and IQN-ILS on a linear model problem with a known fixed point; the
+# interface vector (what the fluid is sent, convergence, best iterate).
+foreach(t accel iter)
+  mps_add_test(test_coupling_${t} SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_coupling_${t}.c
+               LIBS couplercore LABELS unit TIMEOUT 30)
+  target_include_directories(test_coupling_${t} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
+endforeach()
+
+# The static deflection of a body under a hydrostatic load, any solid model
+# (bench/solid_static_load.c; docs/hard_cases.md, the gate against
+# Timoshenko beam theory). A bench program, not a test.
+add_executable(solid_static_load ${CMAKE_SOURCE_DIR}/bench/solid_static_load.c)
+target_link_libraries(solid_static_load PRIVATE solidcore m)
+set_target_properties(solid_static_load PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bench)
+
+# The light plate (cases/hard_light_plate) at 6 mm with rho_s = 10 kg/m3 (a
+# hundredth of the water's), where the explicit scheme diverges at 0.28 s (the
+# fluid's step collapses below dt_min as the plate, beyond its height, whips
+# the water: docs/hard_cases.md; with fluid.kappa_dt = 5e-4 it diverged at
+# 0.28 s, reached 0.45 s at rho_s = 25; with kappa_dt = 0, the default now,
+# at 0.35 s). The
+# implicit run must reach 0.45 s (the first impact and its rebound) with the
+# tip within the plate's height (8.4 cm; measured 3.5 cm) at no more than 10
+# iterations per step on average (the issue's target; measured 7.3 and 7.9
+# with kappa_dt 5e-4 and 0, 18-19 steps accepted at the limit of 20); the
+# explicit run of the same case must not,
+# which shows the check can fail.
+set(LIGHT "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_light_plate/case.yml --quiet --set dp=0.006 --set end_time=0.45 --set solid.bodies.0.rho=10 --set output.interval=0")
+add_test(NAME coupled_light_plate_implicit
+         COMMAND sh -c "${LIGHT} --out ${CMAKE_BINARY_DIR}/test_out/light_implicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_implicit --end 0.45 --tip-bound 0.084 --max-iterations-mean 10"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME coupled_light_plate_explicit_unstable
+         COMMAND sh -c "${LIGHT} --set coupling.scheme=explicit --out ${CMAKE_BINARY_DIR}/test_out/light_explicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_explicit --end 0.45 --tip-bound 0.084 --expect-unstable"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupled_light_plate_implicit coupled_light_plate_explicit_unstable
+                     PROPERTIES TIMEOUT 300 LABELS validation)
+
+# The plate at rest (cases/hard_plate_at_rest) at 6 mm, both schemes, to 2 s.
+# At this spacing the plate is 2 particles thick: alone under the net
+# hydrostatic load it bends 8.53 mm (bench/solid_static_load.c; beam theory
+# 4.28 mm), and the fluid's loads are 16% above hydrostatic, the excess at
+# the free surface (docs/hard_cases.md). Measured over 1-2 s: 11.9 mm
+# (explicit), 12.5 mm (implicit), oscillating by 0.8-1.5 mm (standard
+# deviation). The band, 8.5-14.5 mm, holds the plate at the static deflection
+# its own bending and these loads give, with room for the oscillation; a plate
+# that is not held (a coupling that loses the load) or that runs away leaves it.
+foreach(scheme explicit implicit)
+  add_test(NAME coupled_plate_at_rest_${scheme}
+           COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_plate_at_rest/case.yml --quiet --set dp=0.006 --set end_time=2 --set output.interval=0 --set coupling.scheme=${scheme} --out ${CMAKE_BINARY_DIR}/test_out/rest_${scheme}; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/rest_${scheme} --end 2 --tip-bound 0.03 --static 0.0085 0.0145 1 2"
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(coupled_plate_at_rest_${scheme} PROPERTIES TIMEOUT 300 LABELS validation)
+endforeach()
+
+# The standard plate (cases/dambreak_elastic_plate) at 6 mm to 0.5 s (the
+# run-up and first impact, before the flow turns chaotic: docs/dambreak_plate.md)
+# with both schemes: the implicit run must give the explicit curve within
+# 0.2 cm RMS at no more than 3 iterations per step on average (the issue's
+# targets; measured 0.11 cm and 1.53, 0.125 cm and 1.50 with kappa_dt 0). A plate 1.5 times stiffer differs from
+# it by 0.74 cm RMS, so the band tells a changed physics from the scheme.
+set(STD "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --quiet --set dp=0.006 --set end_time=0.5 --set output.interval=0")
+add_test(NAME coupled_plate_implicit_vs_explicit
+         COMMAND sh -c "${STD} --set coupling.scheme=explicit --out ${CMAKE_BINARY_DIR}/test_out/std_explicit && ${STD} --set coupling.scheme=implicit --out ${CMAKE_BINARY_DIR}/test_out/std_implicit && /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/std_implicit --end 0.5 --tip-bound 0.084 --max-iterations-mean 3 --compare ${CMAKE_BINARY_DIR}/test_out/std_explicit 0.002"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupled_plate_implicit_vs_explicit PROPERTIES TIMEOUT 300 LABELS validation)
+
+# The stiff plate (cases/hard_stiff_plate, E = 1 GPa) at 6 mm to 0.35 s (the
+# first impact), each scheme against the rigid limit: the fake rigid solid
+# in the same flow, whose probe tip_EI is the quasi-static tip of its loads
+# times E I. E I = E b^3/12 (1 - (dp/b)^2) = 108 N m at dp = 6 mm (the
+# lattice's bending stiffness, docs/solid_models.md). The elastic plate
+# bends 0.1 mm, so it feels the rigid plate's loads; over 10 ms running means
+# it must bend between 0.8 and 2 times their quasi-static tip (2: a linear
+# oscillator's largest response to a suddenly applied load; measured 1.17
+# explicit, 1.36 implicit; 1.36 and 1.44 with kappa_dt 0). A plate twice as soft gives 2.7; an unstable one
+# leaves the 1 mm bound.
+foreach(scheme explicit implicit)
+  set(STIFF "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_stiff_plate/case.yml --quiet --set dp=0.006 --set end_time=0.35 --set output.interval=0")
+  add_test(NAME coupled_stiff_plate_${scheme}
+           COMMAND sh -c "${STIFF} --solid fake_solid --out ${CMAKE_BINARY_DIR}/test_out/stiff_rigid_${scheme} && ${STIFF} --set coupling.scheme=${scheme} --out ${CMAKE_BINARY_DIR}/test_out/stiff_${scheme} && /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/stiff_${scheme} --end 0.35 --tip-bound 0.001 --rigid ${CMAKE_BINARY_DIR}/test_out/stiff_rigid_${scheme} 108 0.8 2.0"
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(coupled_stiff_plate_${scheme} PROPERTIES TIMEOUT 300 LABELS validation)
+endforeach()
+
+# The elastic gate's solid against a known answer (docs/hard_cases.md 3a):
+# alone under still water 14 cm deep (load scaled by 0.01: linear), static,
+# against Timoshenko beam theory. The MPS solid at 1 mm (5 particles across)
+# measured +0.7% (-2.5% at 0.5 mm, -2.3% at 0.25 mm): its lattice error stays
+# within 3%, the band. The linear TLSPH solid at 1 mm gives +34% and fails it
+# (it converges from above: +8.6% at 0.5 mm).
+add_test(NAME gate_static_mps
+         COMMAND /usr/bin/python3 tests/coupler/gate_static_check.py ${CMAKE_BINARY_DIR} mps 0.001 0.97 1.03
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(gate_static_mps PROPERTIES TIMEOUT 240 LABELS validation)

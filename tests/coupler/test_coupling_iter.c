@@ -1,0 +1,116 @@
+/* The implicit coupling's interface vector (coupler/coupling_iter.h): what
+ * the fluid is sent (positions and the step's mean velocity), the predictor,
+ * the convergence test on the step's displacement, clamped particles, the
+ * best iterate, and the refusal of an interface that changes. */
+#include <math.h>
+#include <string.h>
+
+#include "coupling_iter.h"
+#include "test_util.h"
+
+#define N 3
+
+static int ids[N] = {4, 7, 9};
+static unsigned char surf[N] = {1, 1, 0}, fixd[N] = {0, 0, 1};
+
+static struct proto_msg state(double (*x)[2], double (*v)[2])
+{
+    struct proto_msg m = proto_msg_make(PROTO_RESULT);
+    m.payload = PROTO_STATE;
+    m.count = N;
+    m.id = ids;
+    m.x = (const double(*)[2])x;
+    m.v = (const double(*)[2])v;
+    m.surface = surf;
+    m.fixed = fixd;
+    return m;
+}
+
+int main(void)
+{
+    struct mps_err err;
+    struct coupling_iter it;
+    double x0[N][2] = {{0, 0}, {0, 1}, {0, -1}}, v0[N][2] = {{1, 0}, {1, 0}, {0, 0}};
+    struct proto_msg ready = state(x0, v0);
+    CHECK(coupling_iter_init(&it, &ready, 0.1, 1e-4, &err) == MPS_OK);
+    CHECK(coupling_iter_len(&it) == 2 * N);
+
+    /* step 1 (no history): x0 + v0 dt; the fluid sees the mean velocity v0,
+     * the clamped particle stays */
+    struct proto_msg send;
+    const double dt = 0.01;
+    CHECK(coupling_iter_start(&it, &ready, dt, &send, &err) == MPS_OK);
+    CHECK(send.count == N && send.id[1] == 7 && send.fixed[2] == 1);
+    CHECK_NEAR(send.x[0][0], 0.01, 1e-15);
+    CHECK_NEAR(send.v[0][0], 1.0, 1e-12);
+    CHECK(send.x[2][0] == 0.0 && send.v[2][0] == 0.0 && send.x[2][1] == -1.0);
+
+    /* the solid answers exactly the prediction: converged (change 0) */
+    double x1[N][2] = {{0.01, 0}, {0.01, 1}, {0, -1}}, v1[N][2] = {{1, 0}, {1, 0}, {0, 0}};
+    struct proto_msg r1 = state(x1, v1);
+    int conv = 0;
+    CHECK(coupling_iter_result(&it, &r1, &conv, &err) == MPS_OK && conv);
+    CHECK_NEAR(it.increment, sqrt(2 * 0.01 * 0.01 / 3), 1e-15);
+
+    /* step 2: linear prediction from the starts x0 -> x1 over dt, here a step
+     * of dt / 2: x1 + (x1 - x0) / 2 */
+    CHECK(coupling_iter_start(&it, &r1, 0.5 * dt, &send, &err) == MPS_OK);
+    CHECK_NEAR(send.x[0][0], 0.015, 1e-15);
+    CHECK_NEAR(send.v[0][0], 1.0, 1e-12);   /* (0.015 - 0.01) / 0.005 */
+    /* an answer 20% of the step's displacement away is not converged at 0.1 */
+    double x2[N][2] = {{0.016, 0}, {0.016, 1}, {0, -1}};
+    struct proto_msg r2 = state(x2, v1);
+    CHECK(coupling_iter_result(&it, &r2, &conv, &err) == MPS_OK && !conv);
+    CHECK_NEAR(it.change, sqrt(2 * 0.001 * 0.001 / 3), 1e-15);
+
+    /* the next iterate (constant relaxation 0.5) halves the gap; the clamped
+     * particle is where the solid has it */
+    struct coupling_accel *a = NULL;
+    CHECK(coupling_accel_create(&a, "constant", 0.5, 0, 0.1, &err) == MPS_OK);
+    CHECK(coupling_accel_begin(a, coupling_iter_len(&it), &err) == MPS_OK);
+    CHECK(coupling_iter_relax(&it, a, &send, &err) == MPS_OK);
+    CHECK_NEAR(send.x[0][0], 0.0155, 1e-15);
+    CHECK_NEAR(send.v[0][0], 0.0055 / 0.005, 1e-12);
+    CHECK(send.x[2][0] == 0.0 && send.x[2][1] == -1.0);
+
+    /* a worse answer: the best input so far is the first one (0.015) */
+    double x3[N][2] = {{0.0175, 0}, {0.0175, 1}, {0, -1}};
+    struct proto_msg r3 = state(x3, v1);
+    CHECK(coupling_iter_result(&it, &r3, &conv, &err) == MPS_OK && !conv);
+    CHECK(coupling_iter_best(&it, &send) == 1);
+    CHECK_NEAR(send.x[0][0], 0.015, 1e-15);
+    /* its answer again: now the last is the best, nothing to repeat */
+    CHECK(coupling_iter_result(&it, &r2, &conv, &err) == MPS_OK);
+    CHECK(coupling_iter_best(&it, &send) == 0);
+
+    /* absolute tolerance, for an interface at rest: a velocity error of
+     * 0.5e-4 m/s converges at 1e-4 m/s, 2e-4 m/s does not */
+    coupling_iter_free(&it);
+    double still[N][2] = {{0}};
+    struct proto_msg rest = state(x0, still);
+    CHECK(coupling_iter_init(&it, &rest, 0.1, 1e-4, &err) == MPS_OK);
+    for (int pass = 0; pass < 2; pass++) {
+        CHECK(coupling_iter_start(&it, &rest, dt, &send, &err) == MPS_OK);
+        double x4[N][2];
+        memcpy(x4, x0, sizeof x4);
+        x4[0][0] += (pass ? 2e-4 : 0.5e-4) * dt;
+        struct proto_msg r4 = state(x4, still);
+        it.dt_prev = 0.0; /* no history: the prediction is the rest state */
+        CHECK(coupling_iter_result(&it, &r4, &conv, &err) == MPS_OK && conv == !pass);
+    }
+
+    /* another interface (fracture): refused with a message */
+    int other[N] = {4, 8, 9};
+    struct proto_msg bad = state(x1, v1);
+    bad.id = other;
+    CHECK(coupling_iter_result(&it, &bad, &conv, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "id 8") != NULL);
+    bad.id = ids;
+    bad.count = N - 1;
+    CHECK(coupling_iter_start(&it, &bad, dt, &send, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "fracture") != NULL);
+
+    coupling_accel_destroy(&a);
+    coupling_iter_free(&it);
+    return test_summary("test_coupling_iter");
+}
