@@ -2,6 +2,7 @@
  * See mps_case.h for the contract. Storage is a plain array with linear
  * lookup: case files have a few hundred keys at most and are read once. */
 #include "mps_case.h"
+#include "mps_cli.h"
 
 #include <errno.h>
 #include <math.h>
@@ -1052,6 +1053,13 @@ int mps_case_has(const struct mps_case *c, const char *fmt, ...)
     abort();
 }
 
+const char *mps_case_text(const struct mps_case *c, const char *fmt, ...)
+{
+    FORMAT_KEY("mps_case_text");
+    const struct entry *e = find_entry(c, key);
+    return e ? e->val : NULL;
+}
+
 int mps_case_count(const struct mps_case *c, const char *fmt, ...)
 {
     FORMAT_KEY("mps_case_count");
@@ -1213,13 +1221,37 @@ static int write_sbuf(void *data, unsigned char *buf, size_t size)
     return sb_add(data, buf, size) == 0;
 }
 
+/* A relative path value (MPS_KEY_PATH) made absolute against the case's
+ * directory, malloc'd; NULL when it needs no change or memory ran out. */
+static char *absolute_path(const struct mps_case *c, const struct entry *e)
+{
+    if (!e->spec || !(e->spec->flags & MPS_KEY_PATH) || !e->val[0] || e->val[0] == '/')
+        return NULL;
+    char dir[4096];
+    if (!mps_realpath(c->dir, dir, sizeof dir))
+        snprintf(dir, sizeof dir, "%s", c->dir);
+    return xprintf("%s/%s", dir, e->val);
+}
+
 char *mps_case_resolved_yaml(const struct mps_case *c)
 {
     struct entry **v = malloc(((size_t)c->n + 1) * sizeof *v);
-    if (!v)
+    /* copies of the entries, so path values can be made absolute: the
+     * resolved file is read from elsewhere (the coupler's OUT) */
+    struct entry *copy = malloc(((size_t)c->n + 1) * sizeof *copy);
+    char **abs_val = calloc((size_t)c->n + 1, sizeof *abs_val);
+    if (!v || !copy || !abs_val) {
+        free(v);
+        free(copy);
+        free(abs_val);
         return NULL;
-    for (int i = 0; i < c->n; i++)
-        v[i] = &c->e[i];
+    }
+    for (int i = 0; i < c->n; i++) {
+        copy[i] = c->e[i];
+        if ((abs_val[i] = absolute_path(c, &c->e[i])))
+            copy[i].val = abs_val[i];
+        v[i] = &copy[i];
+    }
     qsort(v, (size_t)c->n, sizeof *v, cmp_keys);
 
     struct sbuf out = {0};
@@ -1239,6 +1271,10 @@ char *mps_case_resolved_yaml(const struct mps_case *c)
              yaml_emitter_flush(&em);
         yaml_emitter_delete(&em);
     }
+    for (int i = 0; i < c->n; i++)
+        free(abs_val[i]);
+    free(abs_val);
+    free(copy);
     free(v);
     if (!ok || !out.s) {
         free(out.s);

@@ -25,6 +25,7 @@
 #include "mps_h5.h"
 #include "mps_host.h"
 #include "mps_json.h"
+#include "mps_motion.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_timer.h"
@@ -56,6 +57,7 @@ struct peer {
 
 struct coupler {
     struct mps_case *cs;
+    struct mps_motion *motion; /* the tank's motion, checked before launching */
     const char *out;
     struct peer p[NPEERS];
     void *zctx;
@@ -274,6 +276,11 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     char cfg[8192];
     snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n", resolved_case,
              c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0));
+    /* PROTOCOL.md 4: a solver that cannot apply the tank's motion refuses the
+     * key instead of running a fixed tank */
+    if (mps_motion_moving(c->motion))
+        snprintf(cfg + strlen(cfg), sizeof cfg - strlen(cfg), "motion=%s\n",
+                 mps_motion_kind_name(c->motion->kind));
     struct proto_msg conf = proto_msg_make(PROTO_CONFIG);
     conf.text = cfg;
     return proto_link_send(p->sock, &conf, err);
@@ -568,6 +575,11 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
     mps_json_str(&j, "cpu_placement", c->cpu_note);
+    if (c->motion) {
+        mps_json_object(&j, "motion");
+        mps_motion_summary(c->motion, &j);
+        mps_json_close(&j);
+    }
     mps_json_object(&j, "solvers");
     for (int k = 0; k < NPEERS; k++) {
         struct peer *p = &c->p[k];
@@ -629,6 +641,7 @@ static void cleanup(struct coupler *c)
     proto_msg_clear(&c->state);
     proto_msg_clear(&c->loads);
     mps_probes_close(&c->probes);
+    mps_motion_destroy(&c->motion);
     mps_case_destroy(&c->cs);
 }
 
@@ -664,8 +677,9 @@ int main(int argc, char **argv)
     c.p[FLUID].name = "fluid";
     c.p[SOLID].name = "solid";
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
-                                                 solid_case_keys, coupler_case_keys};
-    st = mps_case_load(&c.cs, cli.case_path, cli.sets, cli.nsets, tables, 4, NULL, &err);
+                                                 solid_case_keys, coupler_case_keys,
+                                                 mps_motion_keys};
+    st = mps_case_load(&c.cs, cli.case_path, cli.sets, cli.nsets, tables, 5, NULL, &err);
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
         return mps_status_exit_code(st);
@@ -702,9 +716,12 @@ int main(int argc, char **argv)
             st = fluid_params_read(&fp, c.cs, &err);
         if (!st && sc)
             st = solid_scene_read(sc, c.cs, &err);
+        if (!st)
+            st = mps_motion_read(&c.motion, c.cs, &err);
         free(sc);
         if (st) {
             fprintf(stderr, "coupler: %s\n", err.msg);
+            mps_motion_destroy(&c.motion);
             mps_case_destroy(&c.cs);
             return mps_status_exit_code(st);
         }

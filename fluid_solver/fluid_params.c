@@ -94,7 +94,8 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "column name in probes.csv"},
     {"fluid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
-     "front|height|pressure|bottom_pressure|max_speed|escaped", "", "what the probe measures"},
+     "front|height|pressure|bottom_pressure|max_speed|escaped|tank_angle", "",
+     "what the probe measures"},
     {"fluid.probes.*.x", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
      "probe x (height: column position; pressure: point)"},
     {"fluid.probes.*.y", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
@@ -104,9 +105,9 @@ const struct mps_key_spec fluid_case_keys[] = {
 
 static enum fluid_probe_kind probe_kind(const char *s)
 {
-    static const char *const names[] = {"front", "height", "pressure",
-                                        "bottom_pressure", "max_speed", "escaped"};
-    for (int k = 0; k < 6; k++)
+    static const char *const names[] = {"front",     "height",  "pressure",  "bottom_pressure",
+                                        "max_speed", "escaped", "tank_angle"};
+    for (int k = 0; k < 7; k++)
         if (strcmp(s, names[k]) == 0)
             return (enum fluid_probe_kind)k;
     return FLUID_PROBE_FRONT; /* unreachable: mps_case validated the enum */

@@ -5,6 +5,7 @@
 
 #include "mps_case.h"
 #include "mps_dim.h"
+#include "mps_motion.h"
 
 #define FLUID_MAX_BLOCKS 16
 #define FLUID_MAX_PROBES 32
@@ -24,7 +25,8 @@ enum fluid_probe_kind {
     FLUID_PROBE_PRESSURE,    /* mean pressure of particles within 2 dp of (x, y), Pa */
     FLUID_PROBE_BOTTOM,      /* pressure on the floor (y = 0) under water, Pa */
     FLUID_PROBE_MAX_SPEED,   /* max fluid speed, m/s */
-    FLUID_PROBE_ESCAPED      /* fluid particles outside the tank, count */
+    FLUID_PROBE_ESCAPED,     /* fluid particles outside the tank, count */
+    FLUID_PROBE_TANK_ANGLE   /* the tank's roll angle theta now (motion.*), deg */
 };
 
 struct fluid_probe_def {
@@ -65,6 +67,9 @@ struct fluid_params {
     int nprobes;
     struct fluid_probe_def probes[FLUID_MAX_PROBES];
     double output_interval, probe_interval;
+    /* the tank frame's motion (borrowed from the caller, who reads it with
+     * mps_motion_read; fluid_params_read leaves it NULL: a fixed tank) */
+    const struct mps_motion *motion;
 };
 
 extern const struct mps_key_spec fluid_case_keys[];

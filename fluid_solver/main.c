@@ -33,6 +33,7 @@ static void on_signal(int sig)
 
 struct run {
     struct mps_case *cs;
+    struct mps_motion *motion; /* the tank's motion; the fluid borrows it */
     struct fluid *f;
     struct mps_h5_series *h5;
     struct mps_probes *probes;
@@ -95,6 +96,11 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
         mps_json_str(&j, "cpu_binding", r->cpu_note);
     /* the vector paths set the last bits of the results (MPS_SIMD=sse2) */
     mps_json_str(&j, "simd_paths", mps_simd_wide() ? "avx512" : "portable");
+    if (r->motion) {
+        mps_json_object(&j, "motion");
+        mps_motion_summary(r->motion, &j);
+        mps_json_close(&j);
+    }
     if (r->f)
         fluid_summary(r->f, &j);
     mps_json_end(&j);
@@ -176,13 +182,17 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
 static enum mps_status setup(struct run *r, const char *case_path, const char *const *sets,
                              int nsets, const char *prefix, struct mps_err *err)
 {
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"solid.", "coupling.", NULL};
     enum mps_status st =
-        mps_case_load(&r->cs, case_path, sets, nsets, tables, 2, ignore, err);
+        mps_case_load(&r->cs, case_path, sets, nsets, tables, 3, ignore, err);
     struct fluid_params prm;
-    if (st || (st = fluid_params_read(&prm, r->cs, err)) || (st = mps_mkdir_p(r->out, err)) ||
-        (st = fluid_create(&r->f, &prm, err)))
+    if (st || (st = fluid_params_read(&prm, r->cs, err)) ||
+        (st = mps_motion_read(&r->motion, r->cs, err)) || (st = mps_mkdir_p(r->out, err)))
+        return st;
+    prm.motion = r->motion;
+    if ((st = fluid_create(&r->f, &prm, err)))
         return st;
     char *yaml = mps_case_resolved_yaml(r->cs);
     char path[4200];
@@ -281,6 +291,7 @@ static void teardown(struct run *r)
     mps_probes_close(&r->probes);
     mps_h5_close(&r->h5);
     fluid_destroy(&r->f);
+    mps_motion_destroy(&r->motion);
     mps_case_destroy(&r->cs);
     free(r->load_id);
     free(r->load_p);
@@ -293,7 +304,7 @@ static int run_coupled(const char *endpoint, int hello_timeout_ms)
     r.wall0 = mps_wall_seconds();
     struct mps_err err = {0};
     static const struct proto_solver_ops ops = {"fluid", "mps", peer_configure, peer_ready,
-                                                peer_advance, peer_finish};
+                                                peer_advance, peer_finish, 1};
     enum mps_status st =
         proto_solver_run(endpoint, &ops, &r, hello_timeout_ms, &stop_signal, &r.peer, &err);
     if (st)

@@ -28,6 +28,10 @@ struct proto_solver_ops {
                                struct mps_err *err);
     /* STOP: finish outputs; return the summary as a malloc'd JSON object. */
     char *(*finish)(void *self, enum mps_status st, const struct mps_err *err);
+    /* 1: the solver applies the case's tank motion (the motion.* keys,
+     * mps_motion.h), so it accepts CONFIG motion=KIND; 0: it answers that key
+     * with ERROR input (PROTOCOL.md 4). */
+    int moving_frame;
 };
 
 /* Timing of the conversation, for the solver's summary. */

@@ -108,10 +108,11 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
                            struct mps_err *err)
 {
     double wall_start = mps_wall_seconds();
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
     struct mps_case *c = NULL;
-    enum mps_status st = mps_case_load(&c, cli->case_path, cli->sets, cli->nsets, tables, 2,
+    enum mps_status st = mps_case_load(&c, cli->case_path, cli->sets, cli->nsets, tables, 3,
                                        ignore, err);
     if (st != MPS_OK)
         return st;

@@ -63,9 +63,10 @@ static enum mps_status configure(void *self, const char *case_path, const char *
 {
     struct peer *p = self;
     snprintf(p->out, sizeof p->out, "%s", out);
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
-    enum mps_status st = mps_case_load(&p->cs, case_path, NULL, 0, tables, 2, ignore, err);
+    enum mps_status st = mps_case_load(&p->cs, case_path, NULL, 0, tables, 3, ignore, err);
     if (st)
         return st;
     if (!p->ops && !(p->ops = solid_model_find(mps_case_string(p->cs, "solid.model"))))
@@ -188,7 +189,7 @@ int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int 
     struct peer p = {.ops = ops};
     p.wall0 = mps_wall_seconds();
     struct proto_solver_ops pops = {"solid", ops ? ops->name : "case", configure, ready, advance,
-                                    finish};
+                                    finish, 1};
     struct mps_err err = {0};
     enum mps_status st =
         proto_solver_run(endpoint, &pops, &p, hello_timeout_ms, stop_flag, &p.stats, &err);

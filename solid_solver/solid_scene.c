@@ -67,12 +67,13 @@ const struct mps_key_spec solid_case_keys[] = {
      "clamp region, top"},
     {"solid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "column name in probes.csv"},
-    {"solid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED, "dx|dy|x|y", "",
+    {"solid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
+     "dx|dy|x|y|tank_angle|energy", "",
      "displacement or position component"},
-    {"solid.probes.*.x", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
-     "probe point: the nearest particle(s) at start"},
-    {"solid.probes.*.y", MPS_KEY_DOUBLE, NULL, 0, 0, ANY | MPS_KEY_REQUIRED, NULL, "m",
-     "probe point: the nearest particle(s) at start"},
+    {"solid.probes.*.x", MPS_KEY_DOUBLE, NULL, 0, 0, ANY, NULL, "m",
+     "probe point: the nearest particle(s) at start (kinds dx, dy, x, y)"},
+    {"solid.probes.*.y", MPS_KEY_DOUBLE, NULL, 0, 0, ANY, NULL, "m",
+     "probe point: the nearest particle(s) at start (kinds dx, dy, x, y)"},
     {.name = NULL},
 };
 
@@ -237,12 +238,20 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
                                "list of probes)", mps_case_path(c), k);
         copy_name(d->name, mps_case_string(c, "%s", key));
         const char *kind = mps_case_string(c, "solid.probes.%d.kind", k);
-        d->kind = strcmp(kind, "dx") == 0  ? SOLID_PROBE_DX
-                  : strcmp(kind, "dy") == 0 ? SOLID_PROBE_DY
-                  : strcmp(kind, "x") == 0  ? SOLID_PROBE_X
-                                            : SOLID_PROBE_Y;
-        d->x = mps_case_double(c, "solid.probes.%d.x", k);
-        d->y = mps_case_double(c, "solid.probes.%d.y", k);
+        d->kind = strcmp(kind, "dx") == 0           ? SOLID_PROBE_DX
+                  : strcmp(kind, "dy") == 0         ? SOLID_PROBE_DY
+                  : strcmp(kind, "x") == 0          ? SOLID_PROBE_X
+                  : strcmp(kind, "y") == 0          ? SOLID_PROBE_Y
+                  : strcmp(kind, "tank_angle") == 0 ? SOLID_PROBE_TANK_ANGLE
+                                                    : SOLID_PROBE_ENERGY;
+        int point = d->kind <= SOLID_PROBE_Y;
+        if (point && (!mps_case_has(c, "solid.probes.%d.x", k) ||
+                      !mps_case_has(c, "solid.probes.%d.y", k))) {
+            snprintf(key, sizeof key, "solid.probes.%d.kind", k);
+            return mps_case_fail(c, err, key, "needs the probe point x and y");
+        }
+        d->x = point ? mps_case_double(c, "solid.probes.%d.x", k) : 0.0;
+        d->y = point ? mps_case_double(c, "solid.probes.%d.y", k) : 0.0;
         for (int a = 0; a < k; a++)
             if (strcmp(s->probes[a].name, d->name) == 0)
                 return mps_case_fail(c, err, key, "probe name already used by "
@@ -256,6 +265,9 @@ void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x
 {
     for (int k = 0; k < s->nprobes; k++) {
         const struct solid_probe_def *p = &s->probes[k];
+        probe_n[k] = 0;
+        if (p->kind > SOLID_PROBE_Y)
+            continue; /* not a point probe */
         double best = INFINITY;
         for (size_t i = 0; i < n; i++)
             best = fmin(best, hypot(x0[i][0] - p->x, x0[i][1] - p->y));
@@ -278,9 +290,16 @@ double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
         case SOLID_PROBE_DY: sum += x[i][1] - x0[i][1]; break;
         case SOLID_PROBE_X: sum += x[i][0]; break;
         case SOLID_PROBE_Y: sum += x[i][1]; break;
+        default: return NAN;
         }
     }
     return probe_n[k] ? sum / probe_n[k] : NAN;
+}
+
+double solid_probe_tank_angle(const struct mps_motion *m, double t)
+{
+    return mps_motion_moving(m) ? mps_motion_at(m, t).theta * (180.0 / 3.14159265358979323846)
+                                : 0.0;
 }
 
 enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, size_t n,

@@ -7,6 +7,7 @@
 
 #include "mps_case.h"
 #include "mps_dim.h"
+#include "mps_motion.h"
 #include "mps_err.h"
 #include "solid_model.h"
 
@@ -31,10 +32,12 @@ enum solid_plane { SOLID_PLANE_STRAIN, SOLID_PLANE_STRESS };
 enum solid_contact { SOLID_CONTACT_NONE, SOLID_CONTACT_BODIES, SOLID_CONTACT_ALL };
 
 enum solid_probe_kind {
-    SOLID_PROBE_DX, /* x displacement, m */
-    SOLID_PROBE_DY, /* y displacement, m */
-    SOLID_PROBE_X,  /* x position, m */
-    SOLID_PROBE_Y   /* y position, m */
+    SOLID_PROBE_DX,         /* x displacement, m */
+    SOLID_PROBE_DY,         /* y displacement, m */
+    SOLID_PROBE_X,          /* x position, m */
+    SOLID_PROBE_Y,          /* y position, m */
+    SOLID_PROBE_TANK_ANGLE, /* the tank frame's roll angle now (motion.*), deg */
+    SOLID_PROBE_ENERGY      /* kinetic + elastic energy of all bodies, J per m depth */
 };
 
 struct solid_body_def {
@@ -86,10 +89,14 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
 void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x0)[MPS_DIM],
                          int *probe_n, size_t (*probe_i)[SOLID_PROBE_TIES]);
 
-/* Probe k's current value: the mean over its particles of dx, dy, x or y. */
+/* Probe k's current value: the mean over its particles of dx, dy, x or y
+ * (NAN for the kinds the model answers itself: tank_angle, energy). */
 double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
                          const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
                          const double (*x0)[MPS_DIM]);
+
+/* The tank_angle probe: theta at time t in degrees (0 without motion). */
+double solid_probe_tank_angle(const struct mps_motion *m, double t);
 
 /* Fluid loads (force per particle, N per metre depth) as accelerations:
  * aload[i] = force / (rho_body V), V = dp^2; particles not listed get zero.

@@ -7,6 +7,7 @@ breaks one rule, so ctest can check that the suite catches it:
   --bug step     RESULT echoes step + 1
   --bug abort    ignores ABORT and waits for the next message
   --bug silent   dies on a malformed message without sending ERROR
+  --bug motion   accepts CONFIG motion=KIND (a moving tank) and ignores it
 
 usage: conformance_toy_solid.py [--bug NAME] --connect ENDPOINT
 """
@@ -50,7 +51,9 @@ def converse(sock):
     if cfg.type != mp.Type.CONFIG:
         raise Fail(f'protocol: expected CONFIG, got {mp.Type(cfg.type).name}')
     conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
-    unknown = set(conf) - {'case', 'out', 'prefix', 'timeout_ms'}
+    # it has no body forces: a moving tank (CONFIG motion) is unknown to it
+    unknown = set(conf) - {'case', 'out', 'prefix', 'timeout_ms'} - \
+        ({'motion'} if BUG == 'motion' else set())
     if unknown:
         raise Fail(f"input: CONFIG key '{sorted(unknown)[0]}' unknown")
     with open(conf['case']) as f:

@@ -51,7 +51,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     struct fake *s = self;
     struct mps_case *c = NULL;
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
-    const char *const ignore[] = {"fluid.", "coupling.", NULL};
+    /* motion: a moving case never reaches here (CONFIG motion is refused) */
+    const char *const ignore[] = {"fluid.", "coupling.", "motion.", NULL};
     enum mps_status st = mps_case_load(&c, case_path, NULL, 0, tables, 2, ignore, err);
     if (st)
         return st;
@@ -170,7 +171,9 @@ int main(int argc, char **argv)
         fprintf(stderr, "fake_solid: %s\n", err.msg[0] ? err.msg : "needs --connect ENDPOINT");
         return 2;
     }
-    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready, advance, finish};
+    /* a rigid plate fixed in the tank: it has no body forces to move */
+    static const struct proto_solver_ops ops = {"solid", "fake", configure, ready, advance, finish,
+                                                0};
     enum mps_status st = proto_solver_run(endpoint, &ops, &s, hello_ms, &stop_flag, &stats, &err);
     if (st)
         fprintf(stderr, "fake_solid: %s: %s\n", mps_status_name(st), err.msg);
