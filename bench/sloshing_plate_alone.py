@@ -90,10 +90,11 @@ def main():
                     if r.returncode:
                         rows.append((case, plane, dp, model, L, w0, f0, None, None, r.stderr.strip()))
                         continue
-                    w, T = measure(os.path.join(out, 'probes.csv'))
-                    rows.append((case, plane, dp, model, L, w0, f0, -w, 1.0 / T, ''))
+                    w, period = measure(os.path.join(out, 'probes.csv'))
+                    rows.append((case, plane, dp, model, L, w0, f0, -w, 1.0 / period, ''))
                     print(f'{case} {plane} {model} dp {dp * 1e3:g} mm: static {-w * 1e3:.3f} mm '
-                          f'(E-B {w0 * 1e3:.3f}), f {1 / T:.3f} Hz (E-B {f0:.3f})', file=sys.stderr)
+                          f'(E-B {w0 * 1e3:.3f}), f {1 / period:.3f} Hz (E-B {f0:.3f})',
+                          file=sys.stderr)
     print('| plate | plane | dp (particles thick) | model | free length | static tip (E-B) | '
           'error | frequency (E-B) | error |')
     print('|---|---|---|---|---|---|---|---|---|')
