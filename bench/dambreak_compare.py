@@ -41,7 +41,7 @@ def load_ref(path=REF):
 
 def load_probes(run):
     with open(os.path.join(run, 'probes.csv')) as f:
-        rd = csv.DictReader(f)
+        rd = csv.DictReader(l for l in f if not l.startswith('#'))  # '#': provenance
         cols = {k: [] for k in rd.fieldnames}
         for r in rd:
             for k in cols:

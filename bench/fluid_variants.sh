@@ -65,7 +65,7 @@ import dambreak_compare as dc
 def probes(run):
     try:
         with open(os.path.join(run, 'probes.csv')) as f:
-            return list(csv.DictReader(f))
+            return list(csv.DictReader(l for l in f if not l.startswith('#')))
     except OSError:
         return []
 

@@ -10,10 +10,12 @@ distance between particles of different surfaces, momentum error) and prints
 a markdown table of them.
 
 usage: bench/fracture_pictures.py [--bin build/bin/solid_solver] [--dp 0.0125]
-                                  [--out /tmp/fracture] [--img docs/img] [--reuse]
+                                  [--out /tmp/fracture] [--img DIR] [--reuse]
        bench/fracture_pictures.py --timing [--bin ...] [--dp 0.0125] [--end 0.5]
                                   [--threads 1] [--repeat 3]
-Writes IMG/fracture_collision_dpNNNN.png and IMG/fracture_diagnostics_dpNNNN.png.
+Writes IMG/fracture_collision_dpNNNN.png and IMG/fracture_diagnostics_dpNNNN.png
+(IMG: --img, by default the --out directory; --img docs/img replaces the
+pictures of docs/fracture.md).
 --timing instead runs the case without fracture (solid.eps_max and
 solid.contact removed), with fracture only (contact: none), and with contact
 bodies and all, and prints the cost of each in ns per particle-step (best of
@@ -69,7 +71,9 @@ def snapshots(out):
 def read(path):
     with h5py.File(path, "r") as f:
         g = f["particles"]
-        return {k: g[k][()] for k in ("position", "body", "surface", "id")}
+        snap = {k: g[k][()] for k in ("position", "body", "surface", "id")}
+    snap["position"] = snap["position"][:, :2]  # the files' vectors have 3 components, z = 0
+    return snap
 
 
 def draw(ax, snap, surf0, dp, body, window, title):
@@ -105,7 +109,7 @@ def centre(snap, body):
 
 def probes(out):
     with open(os.path.join(out, "probes.csv")) as f:
-        rows = list(csv.DictReader(f))
+        rows = list(csv.DictReader(l for l in f if not l.startswith('#')))  # '#': provenance
     return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
@@ -199,11 +203,13 @@ def main():
     ap.add_argument("--threads", type=int, default=1, help="--timing: OpenMP threads")
     ap.add_argument("--repeat", type=int, default=3, help="--timing: runs of each")
     ap.add_argument("--out", default="/tmp/fracture")
-    ap.add_argument("--img", default="docs/img")
+    ap.add_argument("--img", help="where the pictures go (default: --out)")
     ap.add_argument("--reuse", action="store_true", help="keep runs that finished")
     ap.add_argument("--table-only", action="store_true",
                     help="only the table of runs already in OUT (no pictures)")
     a = ap.parse_args()
+    if a.img is None:
+        a.img = a.out
     if a.timing:
         return timing(a)
     tag = "dp%04d" % round(a.dp * 1e4)

@@ -16,7 +16,7 @@ EXP_T, EXP_DX = 0.16, 0.046
 
 def load(run):
     with open(os.path.join(run, 'probes.csv')) as f:
-        rows = list(csv.DictReader(f))
+        rows = list(csv.DictReader(l for l in f if not l.startswith('#')))  # '#': provenance
     col = lambda k: np.array([float(r[k]) for r in rows]) if rows and k in rows[0] else None
     return col('time'), col('tip_dx'), col('tip_dy'), col('solid_fx')
 

@@ -134,7 +134,8 @@ def make_plot(rows, path):
     os.makedirs(os.path.dirname(path), exist_ok=True)
     fig, ax = plt.subplots(figsize=(8, 4))
     for r in rows:
-        d = np.genfromtxt(os.path.join(r["out"], "probes.csv"), delimiter=",", names=True)
+        with open(os.path.join(r["out"], "probes.csv")) as f:  # '#' lines: provenance
+            d = np.genfromtxt((l for l in f if not l.startswith("#")), delimiter=",", names=True)
         ls = "-" if r["plane"] == "stress" else ":"
         ax.plot(d["time"], 100 * d["tip_dy"], ls, label=f"b/dp = {r['ratio']} ({r['plane']})")
     ax.axhline(-47.09, color="k", lw=0.8, ls="--", label="Eq. 53 x 2 (-47.09 cm)")

@@ -1,8 +1,9 @@
 /* Case files: YAML -> flat table of dotted keys -> validated against specs.
  * See mps_case.h for the contract. Storage is a plain array with linear
  * lookup: case files have a few hundred keys at most and are read once. */
+/* realpath() is XSI */
+#define _XOPEN_SOURCE 700
 #include "mps_case.h"
-#include "mps_cli.h"
 
 #include <errno.h>
 #include <math.h>
@@ -11,10 +12,17 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <sys/stat.h>
 
 #include <yaml.h>
 
 #define KEY_MAX 512        /* longest key a getter formats */
+/* Bounds that keep a hostile or mistaken file from costing more than a real
+ * case ever needs (ours are a few kB and under 300 keys; lookups are linear,
+ * so the key count bounds the quadratic work of loading). */
+#define CASE_MAX_BYTES (1L << 20)
+#define CASE_MAX_KEYS 10000
+#define CASE_MAX_DEPTH 32
 #define INDEX_MAX_DIGITS 9 /* a sequence index fits an int */
 
 struct value {
@@ -204,37 +212,48 @@ static int add_entry(struct mps_case *c, const char *key, const char *val, size_
     return 0;
 }
 
-/* ---- error list: the loader reports every problem it finds, one a line ---- */
+/* ---- error list: one line (house rule), the first problem in full and
+ * how many more there are, with the next one ---- */
 
 struct errs {
     struct mps_err *err;
-    int n, full;
+    int n;
+    char next[200]; /* the second problem */
 };
 
 static void add_err(struct errs *es, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
 static void add_err(struct errs *es, const char *fmt, ...)
 {
-    static const char more[] = "\n(more errors not shown)";
     char line[sizeof es->err->msg];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(line, sizeof line, fmt, ap);
     va_end(ap);
-    if (es->n++ == 0) {
+    if (es->n++ == 0)
         mps_err_set(es->err, MPS_EINPUT, "%s", line);
-        return;
-    }
-    if (!es->err || es->full)
+    else if (es->n == 2)
+        snprintf(es->next, sizeof es->next, "%.*s", (int)sizeof es->next - 1, line);
+}
+
+/* An error is one line on a terminal: a key or value from the file with a
+ * newline or another control byte in it (quoted YAML allows any) shows '?'
+ * there instead. */
+static void one_line(char *msg)
+{
+    for (unsigned char *p = (unsigned char *)msg; *p; p++)
+        if (*p < 0x20 || *p == 0x7f)
+            *p = '?';
+}
+
+/* Appends "(and N more problems; the next: ...)" to the first one. */
+static void finish_errs(struct errs *es)
+{
+    if (es->n < 2 || !es->err)
         return;
     char *msg = es->err->msg;
-    size_t used = strlen(msg), room = sizeof es->err->msg - used;
-    if (strlen(line) + 1 + sizeof more < room) {
-        snprintf(msg + used, room, "\n%s", line);
-    } else {
-        es->full = 1;
-        if (sizeof more < room)
-            snprintf(msg + used, room, "%s", more);
-    }
+    size_t used = strlen(msg);
+    snprintf(msg + used, sizeof es->err->msg - used, " (and %d more problem%s; the next: %s)",
+             es->n - 1, es->n > 2 ? "s" : "", es->next);
 }
 
 /* ---- values ---- */
@@ -415,7 +434,13 @@ static void suggest(const struct mps_case *c, const char *key, char *out, size_t
 
     const char *best = NULL;
     int bd = 0;
+    int wl = (int)strlen(wild);
     for (int i = 0; i < c->nspecs; i++) {
+        /* the distance is at least the difference in length: a name too
+         * long or too short to be accepted below is not worth aligning */
+        int sl = (int)strlen(c->specs[i].name), room = sl / 4 > 1 ? sl / 4 : 1;
+        if (wl - sl > room || sl - wl > room)
+            continue;
         int d = edit_distance(wild, c->specs[i].name);
         if (!best || d < bd) {
             best = c->specs[i].name;
@@ -478,6 +503,8 @@ struct reader {
 
 static int push_frame(struct reader *r, int seq)
 {
+    if (r->depth >= CASE_MAX_DEPTH)
+        return 1;
     if (r->depth == r->cap) {
         int cap = r->cap ? 2 * r->cap : 16;
         struct frame *st = realloc(r->st, (size_t)cap * sizeof *st);
@@ -528,8 +555,17 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
             if (p->context)
                 snprintf(ctx, sizeof ctx, " (%s at line %lu)", p->context,
                          (unsigned long)p->context_mark.line + 1);
-            return mps_err_set(err, MPS_EINPUT, "%s:%lu: YAML syntax error: %s%s", file,
-                               (unsigned long)p->problem_mark.line + 1,
+            unsigned long at = (unsigned long)p->problem_mark.line + 1;
+            if (p->error == YAML_READER_ERROR) {
+                /* the reader (bad UTF-8, a control byte) gives a byte offset,
+                 * not a line: count the lines up to it */
+                const unsigned char *in = p->input.string.start;
+                size_t off = p->problem_offset, n = (size_t)(p->input.string.end - in);
+                at = 1;
+                for (size_t k = 0; in && k < off && k < n; k++)
+                    at += in[k] == '\n';
+            }
+            return mps_err_set(err, MPS_EINPUT, "%s:%lu: YAML syntax error: %s%s", file, at,
                                p->problem ? p->problem : "unknown", ctx);
         }
         int line = (int)ev.start_mark.line + 1;
@@ -557,7 +593,11 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
             } else if (top->want_key) {
                 FAIL(MPS_EINPUT, "%s:%d: complex mapping keys are not supported", file, line);
             }
-            if (push_frame(r, seq))
+            int pf = push_frame(r, seq);
+            if (pf == 1)
+                FAIL(MPS_EINPUT, "%s:%d: nested deeper than %d levels: not a case file", file,
+                     line, CASE_MAX_DEPTH);
+            if (pf)
                 NOMEM();
             break;
         }
@@ -589,6 +629,9 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
                     if (strcmp(r->seen[i].path, r->path.s) == 0)
                         FAIL(MPS_EINPUT, "%s:%d: duplicate key '%s' (first given at line %d)",
                              file, line, r->path.s, r->seen[i].line);
+                if (r->nseen >= CASE_MAX_KEYS)
+                    FAIL(MPS_EINPUT, "%s:%d: more than %d keys: not a case file", file, line,
+                         CASE_MAX_KEYS);
                 if (r->nseen == r->capseen) {
                     int cap = r->capseen ? 2 * r->capseen : 64;
                     struct seen *sv = realloc(r->seen, (size_t)cap * sizeof *sv);
@@ -614,6 +657,9 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
             if (o)
                 FAIL(MPS_EINPUT, "%s:%d: %s = %s: conflicts with %s (%s); a key cannot be both "
                      "a value and a section", file, line, key, shown(s), o->key, o->where);
+            if (c->n >= CASE_MAX_KEYS)
+                FAIL(MPS_EINPUT, "%s:%d: more than %d keys: not a case file", file, line,
+                     CASE_MAX_KEYS);
             if (add_entry(c, key, s, sn, xprintf("%s:%d", file, line)))
                 NOMEM();
             sb_cut(&r->path, top->base);
@@ -636,21 +682,85 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
 #undef FAIL
 }
 
+/* The whole file, read at most CASE_MAX_BYTES + 1 bytes (a pipe or a device
+ * works too, and never runs on). *len = bytes read. */
+static enum mps_status slurp(const char *path, unsigned char **out, size_t *len,
+                             struct mps_err *err)
+{
+    *out = NULL;
+    *len = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return mps_err_set(err, MPS_EIO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fileno(f), &sb) == 0 && S_ISDIR(sb.st_mode)) {
+        fclose(f);
+        return mps_err_set(err, MPS_EIO, "%s: cannot read: it is a directory, not a case file",
+                           path);
+    }
+    /* grown as it fills: a case is a few kB, the cap is far above */
+    size_t n = 0, cap = 0;
+    unsigned char *buf = NULL;
+    int bad = 0, e = 0;
+    for (;;) {
+        if (n == cap) {
+            size_t ncap = cap ? 2 * cap : 16384;
+            if (ncap > (size_t)CASE_MAX_BYTES + 1)
+                ncap = (size_t)CASE_MAX_BYTES + 1;
+            if (ncap == cap)
+                break; /* the cap is full: too large */
+            unsigned char *nb = realloc(buf, ncap);
+            if (!nb) {
+                free(buf);
+                fclose(f);
+                return mps_err_set(err, MPS_ENOMEM, "%s: out of memory", path);
+            }
+            buf = nb;
+            cap = ncap;
+        }
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) {
+            bad = ferror(f);
+            e = errno;
+            break;
+        }
+    }
+    fclose(f);
+    if (bad) {
+        free(buf);
+        return mps_err_set(err, MPS_EIO, "%s: cannot read: %s", path, strerror(e));
+    }
+    if (n > (size_t)CASE_MAX_BYTES) {
+        free(buf);
+        return mps_err_set(err, MPS_EINPUT, "%s: over %ld bytes: not a case file (ours are a "
+                           "few kB)", path, CASE_MAX_BYTES);
+    }
+    *out = buf;
+    *len = n;
+    return MPS_OK;
+}
+
 static enum mps_status read_file(struct mps_case *c, struct mps_err *err)
 {
-    FILE *f = fopen(c->path, "rb");
-    if (!f)
-        return mps_err_set(err, MPS_EIO, "%s: cannot open: %s", c->path, strerror(errno));
+    unsigned char *text;
+    size_t len;
+    enum mps_status st = slurp(c->path, &text, &len, err);
+    if (st)
+        return st;
     yaml_parser_t p;
     if (!yaml_parser_initialize(&p)) {
-        fclose(f);
+        free(text);
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot start the YAML parser", c->path);
     }
-    yaml_parser_set_input_file(&p, f);
+    yaml_parser_set_input_string(&p, text, len);
     struct reader r = {.c = c};
-    enum mps_status st = read_yaml(&r, &p, err);
+    st = read_yaml(&r, &p, err);
+    if (st == MPS_OK && c->n == 0)
+        st = mps_err_set(err, MPS_EINPUT, "%s: no keys: the case file is empty (a case needs "
+                         "at least dp and end_time)", c->path);
     yaml_parser_delete(&p);
-    fclose(f);
+    free(text);
     free(r.path.s);
     free(r.st);
     for (int i = 0; i < r.nseen; i++)
@@ -871,8 +981,9 @@ static void validate(struct mps_case *c, struct errs *es)
         if (!e->spec) {
             if (is_ignored(c, e->key))
                 continue;
-            char hint[KEY_MAX + 32];
-            suggest(c, e->key, hint, sizeof hint);
+            char hint[KEY_MAX + 32] = "";
+            if (es->n < 2) /* only the first two problems are shown */
+                suggest(c, e->key, hint, sizeof hint);
             add_err(es, "%s: %s = %s: unknown key%s", e->where, e->key, shown(e->val), hint);
         } else if (check_value(e->spec, e->val, &e->v, prob, sizeof prob)) {
             add_err(es, "%s: %s = %s: %s", e->where, e->key, shown(e->val), prob);
@@ -899,7 +1010,7 @@ enum mps_status mps_case_load(struct mps_case **out, const char *path,
     }
 
     enum mps_status st = read_file(c, err);
-    struct errs es = {err, 0, 0};
+    struct errs es = {err, 0, ""};
     for (int i = 0; i < nsets && st == MPS_OK; i++)
         if (apply_set(c, sets[i], &es) == MPS_ENOMEM)
             st = MPS_ENOMEM;
@@ -917,8 +1028,12 @@ enum mps_status mps_case_load(struct mps_case **out, const char *path,
         if (st == MPS_ENOMEM)
             mps_err_set(err, st, "%s: out of memory", path);
     }
-    if (st == MPS_OK && es.n > 0)
+    if (st == MPS_OK && es.n > 0) {
         st = MPS_EINPUT;
+        finish_errs(&es);
+    }
+    if (st != MPS_OK && err)
+        one_line(err->msg);
     if (st != MPS_OK) {
         mps_case_destroy(&c);
         return st;
@@ -1112,11 +1227,14 @@ enum mps_status mps_case_fail(const struct mps_case *c, struct mps_err *err, con
     const struct entry *e = find_entry(c, key);
     const struct mps_key_spec *s = e ? NULL : find_spec(c, key);
     if (e)
-        return mps_err_set(err, MPS_EINPUT, "%s: %s = %s: %s", e->where, key, shown(e->val),
-                           prob);
-    if (s && s->def)
-        return mps_err_set(err, MPS_EINPUT, "default: %s = %s: %s", key, shown(s->def), prob);
-    return mps_err_set(err, MPS_EINPUT, "%s: %s: %s", mps_case_where(c, key), key, prob);
+        mps_err_set(err, MPS_EINPUT, "%s: %s = %s: %s", e->where, key, shown(e->val), prob);
+    else if (s && s->def)
+        mps_err_set(err, MPS_EINPUT, "default: %s = %s: %s", key, shown(s->def), prob);
+    else
+        mps_err_set(err, MPS_EINPUT, "%s: %s: %s", mps_case_where(c, key), key, prob);
+    if (err)
+        one_line(err->msg);
+    return MPS_EINPUT;
 }
 
 const char *mps_case_path(const struct mps_case *c)
@@ -1227,10 +1345,10 @@ static char *absolute_path(const struct mps_case *c, const struct entry *e)
 {
     if (!e->spec || !(e->spec->flags & MPS_KEY_PATH) || !e->val[0] || e->val[0] == '/')
         return NULL;
-    char dir[4096];
-    if (!mps_realpath(c->dir, dir, sizeof dir))
-        snprintf(dir, sizeof dir, "%s", c->dir);
-    return xprintf("%s/%s", dir, e->val);
+    char *dir = realpath(c->dir, NULL);
+    char *abs = xprintf("%s/%s", dir ? dir : c->dir, e->val);
+    free(dir);
+    return abs;
 }
 
 char *mps_case_resolved_yaml(const struct mps_case *c)
@@ -1284,23 +1402,35 @@ char *mps_case_resolved_yaml(const struct mps_case *c)
 }
 
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
-                                        struct mps_err *err)
+                                        const char *comment, struct mps_err *err)
 {
     char *y = mps_case_resolved_yaml(c);
-    if (!y)
+    char *tmp = xprintf("%s.tmp", path);
+    if (!y || !tmp) {
+        free(y);
+        free(tmp);
         return mps_err_set(err, MPS_ENOMEM, "%s: cannot build the resolved configuration",
                            path);
-    FILE *f = fopen(path, "w");
-    if (!f) {
-        free(y);
-        return mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", path,
-                           strerror(errno));
     }
-    int bad = fprintf(f, "# Resolved from %s (defaults filled in, --set applied)\n%s",
-                      c->path, y) < 0;
+    enum mps_status st = MPS_OK;
+    FILE *f = fopen(tmp, "w");
+    if (!f) {
+        st = mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", tmp, strerror(errno));
+        goto done;
+    }
+    int bad = fprintf(f, "# Resolved from %s (defaults filled in, --set applied)\n%s%s", c->path,
+                      comment ? comment : "", y) < 0;
     bad |= fclose(f) != 0;
+    if (bad) {
+        st = mps_err_set(err, MPS_EIO, "%s: cannot write: %s", tmp, strerror(errno));
+        remove(tmp);
+    } else if (rename(tmp, path) != 0) {
+        st = mps_err_set(err, MPS_EIO, "cannot rename '%s' to '%s': %s", tmp, path,
+                         strerror(errno));
+        remove(tmp);
+    }
+done:
+    free(tmp);
     free(y);
-    if (bad)
-        return mps_err_set(err, MPS_EIO, "%s: cannot write: %s", path, strerror(errno));
-    return MPS_OK;
+    return st;
 }

@@ -108,9 +108,11 @@ char *mps_case_resolved_yaml(const struct mps_case *c);
 
 /* Writes the resolved configuration to path as a YAML file that
  * mps_case_load reads back to the same values (used by the coupler to hand
- * one resolved case to every solver). */
+ * one resolved case to every solver), after a comment line naming the case
+ * and the comment lines given (each "# ...\n"; NULL: none). Written through
+ * path.tmp and rename(), so a reader never sees half a file. */
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
-                                        struct mps_err *err);
+                                        const char *comment, struct mps_err *err);
 
 /* Specs every program shares: dp, end_time, gravity, output.*. */
 extern const struct mps_key_spec mps_case_common_keys[];

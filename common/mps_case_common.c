@@ -20,5 +20,15 @@ const struct mps_key_spec mps_case_common_keys[] = {
      "command of the solid program (a bare name is looked up beside the coupler first)"},
     {"fluid_solver", MPS_KEY_STRING, "fluid_solver", 0, 0, 0, NULL, "",
      "command of the fluid program"},
+    /* provenance (mps_prov.h): set by the program the user started, kept by
+     * the solvers the coupler launches; a value in a case file is replaced */
+    {"run.command", MPS_KEY_STRING, "", 0, 0, 0, NULL, "",
+     "the command line that started the run (written by the program)"},
+    {"run.hostname", MPS_KEY_STRING, "", 0, 0, 0, NULL, "",
+     "name of the machine the run started on (written by the program)"},
+    {"run.host", MPS_KEY_STRING, "", 0, 0, 0, NULL, "",
+     "its CPU and CPU count (written by the program)"},
+    {"run.started", MPS_KEY_STRING, "", 0, 0, 0, NULL, "",
+     "when the run started, UTC, ISO 8601 (written by the program)"},
     {.name = NULL},
 };

@@ -16,7 +16,7 @@ static void print_help(const char *usage, const struct mps_cli_extra *extra, int
     if (usage && usage[0])
         printf("%s%s", usage, usage[strlen(usage) - 1] == '\n' ? "" : "\n");
     printf("\nOptions:\n"
-           "  --out DIR            output directory (created if missing)\n"
+           "  --out DIR            output directory (required; created if missing)\n"
            "  --set KEY=VALUE      override a case-file key; repeatable\n"
            "  --quiet              no progress output\n"
            "  --version            show the version and git revision it was built from\n"

@@ -13,15 +13,18 @@
 #include "mps_version.h"
 
 /* XDMF notes (why the index looks the way it does):
- * - Version 2.0 with implicit Polyvertex topology (NumberOfElements, no
- *   connectivity array), the form SWIFT and other particle codes write; ParaView
- *   ("XDMF Reader", and the Xdmf3 readers) and VisIt read it.
- * - Positions are 2-component ("XY") in 2D; the reader pads z = 0.
- * - Vector fields are written as they are stored, n x MPS_DIM. In 2D that is a
- *   2-component "Vector": ParaView shows it (colouring, magnitude, stream
- *   tracers), but the Glyph filter wants 3 components, so for arrows use a
- *   Calculator "velocity_X*iHat+velocity_Y*jHat". We do not pad the HDF5 data
- *   with zeros: it would cost 50% more disk for every vector field.
+ * - Version 2.0, Polyvertex topology: one vertex cell per particle, with its
+ *   connectivity 0 .. n-1 stored in each file (/topology, 4 bytes a
+ *   particle). The implicit form (NumberOfElements alone, what SWIFT writes)
+ *   gives cells with ParaView's XDMF Reader but none with Xdmf3ReaderS, which
+ *   then draws nothing in the Points or Surface representation.
+ * - Positions and vector fields have 3 components in the files, z = 0 in 2D
+ *   (geometry "XYZ"). XDMF defines a Vector as 3 values: ParaView's XDMF
+ *   Reader pads a 2-component one, but Xdmf3ReaderS (what OpenDataFile picks)
+ *   keeps 2 components, and WarpByVector then aborts pvpython on an assertion
+ *   and a Calculator's mag() finds no vector. The padding costs a third more
+ *   disk per vector field; tests/paraview opens every kind of output with both
+ *   readers.
  * - File names are relative to the .xmf, so a run directory can be moved.
  * - The text is regular on purpose: one element per line, each snapshot a
  *   block from `<Grid ... GridType="Uniform">` to `</Grid>` with one
@@ -256,12 +259,45 @@ static void h5_types(enum mps_field_type type, hid_t *ftype, hid_t *mtype)
     }
 }
 
-/* /particles/NAME: n or n x ncomp values with a "units" attribute. */
+static size_t type_bytes(enum mps_field_type type)
+{
+    return type == MPS_F64 ? sizeof(double) : type == MPS_I32 ? sizeof(int) : 1;
+}
+
+/* Components a field has in the files: vectors get MPS_H5_VEC. */
+static int file_ncomp(int ncomp)
+{
+    return ncomp == MPS_DIM ? MPS_H5_VEC : ncomp;
+}
+
+/* A copy of n vectors of MPS_DIM components padded with zeros to
+ * MPS_H5_VEC; NULL when out of memory. */
+static void *pad_vectors(const void *data, size_t n, enum mps_field_type type)
+{
+    size_t b = type_bytes(type);
+    char *out = calloc(n ? n : 1, MPS_H5_VEC * b);
+    if (out)
+        for (size_t i = 0; i < n; i++)
+            memcpy(out + i * MPS_H5_VEC * b, (const char *)data + i * MPS_DIM * b, MPS_DIM * b);
+    return out;
+}
+
+/* /particles/NAME: n or n x ncomp values (vectors padded to MPS_H5_VEC) with
+ * a "units" attribute and, if given, a "legend". */
 static enum mps_status write_field(hid_t group, const char *name, int ncomp,
                                    enum mps_field_type type, size_t n, const void *data,
-                                   const char *units, const char *path, struct mps_err *err)
+                                   const char *units, const char *legend, const char *path,
+                                   struct mps_err *err)
 {
     enum mps_status st = MPS_OK;
+    void *padded = NULL;
+    if (ncomp == MPS_DIM && MPS_DIM != MPS_H5_VEC && n > 0) {
+        if (!(padded = pad_vectors(data, n, type)))
+            return mps_err_set(err, MPS_ENOMEM, "%s: out of memory writing /particles/%s", path,
+                               name);
+        data = padded;
+    }
+    ncomp = file_ncomp(ncomp);
     hsize_t dims[2] = {(hsize_t)n, (hsize_t)ncomp};
     hid_t ftype, mtype, sp = -1, d = -1;
     h5_types(type, &ftype, &mtype);
@@ -279,11 +315,50 @@ static enum mps_status write_field(hid_t group, const char *name, int ncomp,
         goto done;
     }
     st = attr_str(d, "units", units, path, err);
+    if (st == MPS_OK && legend)
+        st = attr_str(d, "legend", legend, path, err);
 done:
     if (d >= 0 && H5Dclose(d) < 0 && st == MPS_OK)
         st = h5_fail(err, path, "H5Dclose(/particles/%s)", name);
     if (sp >= 0)
         H5Sclose(sp);
+    free(padded);
+    return st;
+}
+
+/* /topology: 0 .. n-1, the XDMF Polyvertex connectivity (see the notes at
+ * the top). */
+static enum mps_status write_topology(hid_t file, size_t n, const char *path, struct mps_err *err)
+{
+    int *idx = malloc((n ? n : 1) * sizeof *idx);
+    if (!idx)
+        return mps_err_set(err, MPS_ENOMEM, "%s: out of memory writing /topology", path);
+    for (size_t i = 0; i < n; i++)
+        idx[i] = (int)i;
+    hsize_t dims[1] = {(hsize_t)n};
+    enum mps_status st = MPS_OK;
+    hid_t sp = -1, d = -1;
+    if ((sp = H5Screate_simple(1, dims, NULL)) < 0) {
+        st = h5_fail(err, path, "H5Screate_simple(/topology)");
+        goto done;
+    }
+    if ((d = H5Dcreate2(file, "topology", H5T_STD_I32LE, sp, H5P_DEFAULT, H5P_DEFAULT,
+                        H5P_DEFAULT)) < 0) {
+        st = h5_fail(err, path, "H5Dcreate2(/topology)");
+        goto done;
+    }
+    if (n > 0 && H5Dwrite(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, idx) < 0) {
+        st = h5_fail(err, path, "H5Dwrite(/topology)");
+        goto done;
+    }
+    st = attr_str(d, "meaning", "XDMF Polyvertex connectivity: particle i is vertex cell i", path,
+                  err);
+done:
+    if (d >= 0 && H5Dclose(d) < 0 && st == MPS_OK)
+        st = h5_fail(err, path, "H5Dclose(/topology)");
+    if (sp >= 0)
+        H5Sclose(sp);
+    free(idx);
     return st;
 }
 
@@ -303,7 +378,7 @@ static void xdmf_dataitem(FILE *f, size_t n, int ncomp, enum mps_field_type type
 {
     fprintf(f, "     <DataItem Dimensions=\"%zu", n);
     if (ncomp != 1)
-        fprintf(f, " %d", ncomp);
+        fprintf(f, " %d", file_ncomp(ncomp));
     fprintf(f, "\" %s Format=\"HDF\">", xdmf_number(type));
     xml_escaped(f, file);
     fputs(":/particles/", f);
@@ -327,8 +402,12 @@ static char *xdmf_grid(const char *gridname, const char *file, double time, size
     fmt_time(tb, time);
     fprintf(f, "    <Time Value=\"%s\"/>\n", tb);
     fprintf(f, "    <Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
-               "NodesPerElement=\"1\"/>\n", n);
-    fprintf(f, "    <Geometry GeometryType=\"%s\">\n", MPS_DIM == 2 ? "XY" : "XYZ");
+               "NodesPerElement=\"1\">\n", n);
+    fprintf(f, "     <DataItem Dimensions=\"%zu\" %s Format=\"HDF\">", n, xdmf_number(MPS_I32));
+    xml_escaped(f, file);
+    fputs(":/topology</DataItem>\n", f);
+    fputs("    </Topology>\n", f);
+    fputs("    <Geometry GeometryType=\"XYZ\">\n", f);
     xdmf_dataitem(f, n, MPS_DIM, MPS_F64, file, "position");
     fputs("    </Geometry>\n", f);
     for (int k = 0; k < nfields; k++) {
@@ -504,15 +583,18 @@ enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, si
         (st = attr_str(fid, "solver", s->solver, tmp, err)) ||
         (st = write_config(fid, s->config, tmp, err)))
         goto done;
+    if ((st = write_topology(fid, n, tmp, err)))
+        goto done;
     if ((grp = H5Gcreate2(fid, "particles", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT)) < 0) {
         st = h5_fail(err, tmp, "H5Gcreate2(/particles)");
         goto done;
     }
-    if ((st = write_field(grp, "position", MPS_DIM, MPS_F64, n, x, "m", tmp, err)))
+    if ((st = write_field(grp, "position", MPS_DIM, MPS_F64, n, x, "m", NULL, tmp, err)))
         goto done;
     for (int k = 0; k < nfields; k++) {
         const struct mps_field *f = &fields[k];
-        if ((st = write_field(grp, f->name, f->ncomp, f->type, n, f->data, f->units, tmp, err)))
+        if ((st = write_field(grp, f->name, f->ncomp, f->type, n, f->data, f->units, f->legend,
+                              tmp, err)))
             goto done;
     }
 done:

@@ -1,13 +1,17 @@
 /* Field output: one HDF5 file per snapshot (closed after writing, so a run
  * that dies leaves every earlier snapshot readable), and an XDMF index that is
  * rewritten atomically (write to a temporary file, rename) after each snapshot
- * so ParaView can open the series at any moment.
+ * so ParaView can open the series at any moment. docs/output.md describes the
+ * files for their readers.
  *
- * Snapshot layout (FILE = DIR/PREFIX_NNNNNN.h5):
+ * Snapshot layout (FILE = DIR/PREFIX_NNNNNN.h5, NNNNNN the snapshot index):
  *   /            attributes: time (s), step, code_version, git_rev, solver
- *   /config      string dataset: the resolved case (YAML)
- *   /particles/position  n x MPS_DIM float64 (m)
- *   /particles/<field>   n or n x ncomp, float64 / int32 / uint8, attribute "units"
+ *   /config      string dataset: the resolved case (YAML, with run.* saying
+ *                which command ran it, on which host, when)
+ *   /particles/position  n x 3 float64 (m); z = 0 in 2D
+ *   /particles/<field>   n, n x 3 (vectors: z = 0 in 2D) or n x ncomp,
+ *                        float64 / int32 / uint8, attribute "units" and, for
+ *                        coded fields, "legend" ("0 fluid, 1 wall, ...")
  * XDMF: DIR/PREFIX.xmf, a temporal collection of Polyvertex grids. */
 #ifndef MPS_H5_H
 #define MPS_H5_H
@@ -19,12 +23,19 @@
 
 enum mps_field_type { MPS_F64, MPS_I32, MPS_U8 };
 
+/* Components of a vector in the files: 3 whatever MPS_DIM is, since
+ * ParaView's Xdmf3 reader keeps a 2-component "Vector" as it is and its
+ * WarpByVector and Calculator then fail on it (XDMF defines a Vector as 3
+ * values). The memory layout stays MPS_DIM. */
+#define MPS_H5_VEC 3
+
 struct mps_field {
     const char *name;   /* "pressure", "velocity", "type" */
-    int ncomp;          /* 1 for scalars, MPS_DIM for vectors */
+    int ncomp;          /* 1 for scalars, MPS_DIM for vectors (written as MPS_H5_VEC) */
     enum mps_field_type type;
     const void *data;   /* n * ncomp values, borrowed */
     const char *units;
+    const char *legend; /* what the codes of an integer field mean, or NULL */
 };
 
 struct mps_h5_series;

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #define PI 3.14159265358979323846 /* M_PI is not POSIX */
 #define DEG (PI / 180.0)
@@ -173,6 +174,11 @@ static enum mps_status read_table(struct mps_motion *m, const char *path, double
     FILE *fp = fopen(path, "r");
     if (!fp)
         return mps_err_set(err, MPS_EIO, "%s: cannot open: %s", path, strerror(errno));
+    struct stat sb;
+    if (fstat(fileno(fp), &sb) != 0 || !S_ISREG(sb.st_mode)) {
+        fclose(fp); /* a device or a pipe could feed lines for ever */
+        return mps_err_set(err, MPS_EINPUT, "%s: not a regular file", path);
+    }
     size_t n = 0, cap = 0;
     double *t = NULL, *y = NULL;
     char line[1024];
@@ -334,7 +340,15 @@ static enum mps_status read_table_kind(struct mps_motion *m, const struct mps_ca
     /* whole spans from 0 to the last row: an end span with one or two rows
      * would leave its coefficients to the noise */
     const double want = mps_case_double(c, "motion.table.knot_spacing");
-    m->nspan = (int)fmax(1.0, floor(m->t_end / want + 0.5));
+    const double spans = fmax(1.0, floor(m->t_end / want + 0.5));
+    if (spans > (double)n) { /* more coefficients than rows: nothing to fit them to */
+        free(t);
+        free(y);
+        return mps_case_fail(c, err, "motion.table.knot_spacing",
+                             "%.0f knot spans over %g s for %zu rows: at most one span per row",
+                             spans, m->t_end, n);
+    }
+    m->nspan = (int)spans;
     m->h = m->t_end / m->nspan;
     st = fit_table(m, t, y, n, m->table_file, err);
     free(t);

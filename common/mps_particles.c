@@ -21,7 +21,17 @@ void mps_particles_add_field(struct mps_particles *ps, const char *name, int nco
 {
     if (ps->nfields >= MPS_PARTICLES_MAX_FIELDS)
         abort(); /* programmer error: raise MPS_PARTICLES_MAX_FIELDS */
-    ps->f[ps->nfields++] = (struct mps_pfield){name, ncomp, type, data, units, output};
+    ps->f[ps->nfields++] = (struct mps_pfield){name, ncomp, type, data, units, output, NULL};
+}
+
+void mps_particles_set_legend(struct mps_particles *ps, const char *name, const char *legend)
+{
+    for (int k = 0; k < ps->nfields; k++)
+        if (strcmp(ps->f[k].name, name) == 0) {
+            ps->f[k].legend = legend;
+            return;
+        }
+    abort(); /* programmer error: no such field */
 }
 
 enum mps_status mps_particles_resize(struct mps_particles *ps, size_t n, struct mps_err *err)
@@ -111,7 +121,7 @@ int mps_particles_output(const struct mps_particles *ps, struct mps_field *out, 
     for (int k = 0; k < ps->nfields && m < max; k++)
         if (ps->f[k].output)
             out[m++] = (struct mps_field){ps->f[k].name, ps->f[k].ncomp, ps->f[k].type,
-                                          *ps->f[k].data, ps->f[k].units};
+                                          *ps->f[k].data, ps->f[k].units, ps->f[k].legend};
     return m;
 }
 

@@ -19,6 +19,7 @@ struct mps_pfield {
     void **data;        /* address of the solver's pointer to the array */
     const char *units;
     int output;         /* written to snapshots */
+    const char *legend; /* what an integer field's codes mean (HDF5 attribute), or NULL */
 };
 
 struct mps_particles {
@@ -32,6 +33,9 @@ void mps_particles_init(struct mps_particles *ps);
 void mps_particles_add_field(struct mps_particles *ps, const char *name, int ncomp,
                              enum mps_field_type type, void **data, const char *units,
                              int output);
+/* Sets the legend of the field called name (must exist): the meaning of its
+ * codes, written with it into every snapshot. */
+void mps_particles_set_legend(struct mps_particles *ps, const char *name, const char *legend);
 /* Sets the count to n, growing every array (new entries zeroed). */
 enum mps_status mps_particles_resize(struct mps_particles *ps, size_t n, struct mps_err *err);
 /* Reorders the first m particles of every field: new[i] = old[perm[i]] for

@@ -38,7 +38,7 @@ static enum mps_status flush_row(struct mps_probes *p, struct mps_err *err)
     return MPS_OK;
 }
 
-enum mps_status mps_probes_open(struct mps_probes **out, const char *path,
+enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const char *comment,
                                 const char *const *names, int n, struct mps_err *err)
 {
     *out = NULL;
@@ -58,6 +58,8 @@ enum mps_status mps_probes_open(struct mps_probes **out, const char *path,
         mps_probes_close(&p);
         return st;
     }
+    if (comment)
+        fputs(comment, p->f);
     fputs("time", p->f);
     for (int k = 0; k < n; k++) {
         fputc(',', p->f);

@@ -1,6 +1,8 @@
-/* probes.csv: a header row "time,<name>,..." and one row per probe interval.
- * Each row is flushed as written, so the file is complete up to the last row
- * if the process dies. */
+/* probes.csv: comment lines "# key: value" saying how the run was made
+ * (mps_prov_comment: program, version, case, command, host, start time), a
+ * header row "time,<name>,..." and one row per probe interval. Readers skip
+ * the lines starting with '#' (pandas: comment='#'). Each row is flushed as
+ * written, so the file is complete up to the last row if the process dies. */
 #ifndef MPS_PROBES_H
 #define MPS_PROBES_H
 
@@ -8,7 +10,8 @@
 
 struct mps_probes;
 
-enum mps_status mps_probes_open(struct mps_probes **out, const char *path,
+/* comment: "# ..." lines written first, verbatim (NULL: none). */
+enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const char *comment,
                                 const char *const *names, int n, struct mps_err *err);
 /* One row: time then n values (%.9g). */
 enum mps_status mps_probes_write(struct mps_probes *p, double time, const double *values,

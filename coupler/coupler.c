@@ -1,6 +1,9 @@
 /* coupler: the program users run, for every case.
  *   coupler CASE.yml --out DIR [--set key=value]... [--quiet]
  *           [--solid "COMMAND"] [--fluid "COMMAND"] [--external fluid|solid]
+ * --out is required; --solid, --fluid and --external are refused for a
+ * solver the case does not need. The run's record (coupler_record.h) goes
+ * into OUT/case_resolved.yml, which the solvers read.
  * It validates the whole case, launches the solvers the scene needs, talks to
  * them over ZeroMQ (proto/PROTOCOL.md) and owns simulation time: each step
  * the fluid advances with the solid's interface as its moving boundary, and
@@ -18,7 +21,9 @@
 #include <zmq.h>
 
 #include "coupler_keys.h"
+#include "coupler_record.h"
 #include "fluid_params.h"
+#include "guard.h"
 #include "launch.h"
 #include "mps_case.h"
 #include "mps_cli.h"
@@ -28,15 +33,20 @@
 #include "mps_motion.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
+#include "mps_prov.h"
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_link.h"
+#include "scene_check.h"
 #include "solid_scene.h"
 
 #define MAX_PROBES 64
 #define SLICE_MS 200
 
 enum { FLUID = 0, SOLID = 1, NPEERS = 2 };
+_Static_assert((int)FLUID == (int)COUPLER_RECORD_FLUID &&
+                   (int)SOLID == (int)COUPLER_RECORD_SOLID &&
+                   (int)NPEERS == (int)COUPLER_RECORD_PEERS, "peer indices");
 
 struct peer {
     const char *name;
@@ -44,6 +54,7 @@ struct peer {
     int engaged;               /* handshake started: its socket is listened to */
     char endpoint[512];
     char ipc_path[108];        /* a Unix socket path's limit (sun_path) */
+    char key_path[300];        /* tcp: its CURVE key file in the run directory */
     void *sock;
     struct child child;
     double dt;                 /* latest stable step it reported */
@@ -53,14 +64,22 @@ struct peer {
     double roundtrip_seconds;  /* ADVANCE sent -> RESULT received */
     long exchanges;
     char *bye;                 /* its summary JSON */
+    char model[64];            /* as its HELLO announced it */
 };
+
+/* the case's key tables: common, fluid, solid, coupler, motion */
+#define NTABLES 5
 
 struct coupler {
     struct mps_case *cs;
     struct mps_motion *motion; /* the tank's motion, checked before launching */
+    const struct mps_key_spec *const *tables; /* the case's key tables (NTABLES) */
+    struct coupler_record rec;
     const char *out;
     struct peer p[NPEERS];
     void *zctx;
+    struct guard *guard;       /* tcp: ZAP handler, refused connections */
+    struct proto_curve curve;  /* tcp: this run's server key pair */
     char rundir[256];
     char cpu_note[160];    /* what coupling.pin_cpus did, for the summary */
     int quiet;
@@ -223,17 +242,49 @@ static enum mps_status expect(struct coupler *c, int k, struct proto_msg *m, enu
 
 /* ---- startup ---- */
 
+/* tcp: CURVE with keys made for this run (PROTOCOL.md section 10). The
+ * solver's key file goes into the private run directory; the ZAP handler
+ * accepts that solver's public key on its endpoint and nothing else. */
+static enum mps_status open_tcp_endpoint(struct coupler *c, int k, struct mps_err *err)
+{
+    struct peer *p = &c->p[k];
+    long port = mps_case_int(c->cs, "coupling.tcp_port") + k;
+    const char *bind_host = mps_case_string(c->cs, "coupling.tcp_bind");
+    char bind[320];
+    snprintf(bind, sizeof bind, "tcp://%s:%ld", bind_host, port);
+    snprintf(p->endpoint, sizeof p->endpoint, "tcp://%s:%ld",
+             mps_case_string(c->cs, "coupling.tcp_host"), port);
+    enum mps_status st;
+    if (!c->guard) {
+        if ((st = proto_key_pair(c->curve.server_public, c->curve.server_secret, err)) ||
+            (st = guard_create(&c->guard, c->zctx, err)))
+            return st;
+    }
+    struct proto_curve ck = c->curve;
+    if ((st = proto_key_pair(ck.client_public, ck.client_secret, err)))
+        return st;
+    snprintf(p->key_path, sizeof p->key_path, "%s/%s.key", c->rundir, p->name);
+    st = proto_key_write(p->key_path, &ck, err);
+    if (st)
+        p->key_path[0] = '\0';
+    else
+        st = guard_allow(c->guard, p->name, ck.client_public, err);
+    memset(&ck, 0, sizeof ck); /* the coupler keeps only the public half */
+    if (st)
+        return st;
+    if ((st = proto_link_open_secure(c->zctx, PROTO_LINK_BIND, bind, &c->curve, p->name,
+                                     &p->sock, err)))
+        return mps_err_prefix(err, "coupling.tcp_bind = %s, coupling.tcp_port = %ld: ",
+                              bind_host, port - k);
+    /* from here every connection refused on this socket is counted */
+    return guard_watch(c->guard, p->sock, p->name, err);
+}
+
 static enum mps_status open_endpoint(struct coupler *c, int k, struct mps_err *err)
 {
     struct peer *p = &c->p[k];
-    if (strcmp(mps_case_string(c->cs, "coupling.transport"), "tcp") == 0) {
-        long port = mps_case_int(c->cs, "coupling.tcp_port") + k;
-        char bind[64];
-        snprintf(bind, sizeof bind, "tcp://*:%ld", port);
-        snprintf(p->endpoint, sizeof p->endpoint, "tcp://%s:%ld",
-                 mps_case_string(c->cs, "coupling.tcp_host"), port);
-        return proto_link_open(c->zctx, PROTO_LINK_BIND, bind, &p->sock, err);
-    }
+    if (strcmp(mps_case_string(c->cs, "coupling.transport"), "tcp") == 0)
+        return open_tcp_endpoint(c, k, err);
     int len = snprintf(p->ipc_path, sizeof p->ipc_path, "%s/%s.sock", c->rundir, p->name);
     if (len < 0 || (size_t)len >= sizeof p->ipc_path)
         return mps_err_set(err, MPS_EIO, "coupler: socket path %s/%s.sock is longer than %zu bytes",
@@ -253,7 +304,12 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     struct peer *p = &c->p[k];
     struct proto_msg m = {0};
     p->engaged = 1;
-    if (p->external && !c->quiet)
+    if (p->external && !c->quiet && p->key_path[0])
+        fprintf(stderr,
+                "coupler: waiting for the %s solver: copy %s to its host (keep it private: "
+                "mode 600) and run it with --connect %s --key FILE\n",
+                p->name, p->key_path, p->endpoint);
+    else if (p->external && !c->quiet)
         fprintf(stderr, "coupler: waiting for the %s solver: run it with --connect %s\n", p->name,
                 p->endpoint);
     enum mps_status st = expect(c, k, &m, PROTO_HELLO,
@@ -272,7 +328,16 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
         return mps_err_set(err, MPS_EPROTO, "%s", reason);
     }
+    char model[64] = "";
+    proto_text_get(m.text, ' ', "model", model, sizeof model);
+    snprintf(p->model, sizeof p->model, "%s", model);
     proto_msg_clear(&m);
+    /* the file this solver is about to read records its own run */
+    enum mps_status rst = coupler_record_hello(
+        &c->rec, &c->cs, c->tables, NTABLES, k,
+        p->external ? "(external: started by the user)" : p->child.command, p->model, err);
+    if (rst)
+        return rst;
     char cfg[8192];
     snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n", resolved_case,
              c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0));
@@ -385,12 +450,18 @@ static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
     }
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", c->out);
-    return mps_probes_open(&c->probes, path, names, n, err);
+    char *comment = mps_prov_comment(c->cs, "coupler");
+    enum mps_status st = mps_probes_open(&c->probes, path, comment, names, n, err);
+    free(comment);
+    return st;
 }
 
 /* The next coupling step: the fluid's CFL step (or, for a solid alone, the
- * probe interval, over which the solid sub-cycles), shortened so output
- * times are hit exactly with no sliver left before them. */
+ * probe interval, over which the solid sub-cycles), shortened so t_next is
+ * hit exactly with no sliver left before it. With a fluid, t_next is the
+ * end of the run only: output and probe times are written at the end of the
+ * first step that reaches them, so they never change the solution
+ * (docs/pressure.md). */
 static double next_dt(const struct coupler *c, double t_next, double probe_interval)
 {
     double dt = c->p[FLUID].needed ? c->p[FLUID].dt : probe_interval;
@@ -417,9 +488,9 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
     while (c->time < end - eps) {
         double t_out = out_iv > 0.0 ? out_k * out_iv : INFINITY;
         double t_probe = probe_k * probe_iv;
-        double t_next = fmin(t_out, end);
-        if (!c->p[FLUID].needed)
-            t_next = fmin(t_next, t_probe); /* a lone solid reports at probe times */
+        double t_next = end;
+        if (!c->p[FLUID].needed) /* a lone solid steps from report to report */
+            t_next = fmin(fmin(t_out, end), t_probe);
         double dt = next_dt(c, t_next, probe_iv);
         uint32_t flags = 0;
         if (c->time + dt >= t_out - eps)
@@ -479,7 +550,8 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
                 probe_k++;
         }
         if (flags & PROTO_F_SNAPSHOT)
-            out_k++;
+            while (out_k * out_iv <= c->time + eps)
+                out_k++;
         mps_progress_update(&prog, c->time, c->step);
     }
     mps_progress_finish(&prog, c->time, c->step);
@@ -529,6 +601,17 @@ static void abort_all(struct coupler *c, const char *reason)
         launch_reap(&c->p[k].child, 5.0);
 }
 
+/* The number after "key": in a solver's summary JSON (its BYE), or def. */
+static double bye_number(const struct peer *p, const char *key, double def)
+{
+    char quoted[96];
+    snprintf(quoted, sizeof quoted, "\"%s\"", key);
+    const char *s = p->bye ? strstr(p->bye, quoted) : NULL;
+    if (s && (s = strchr(s + strlen(quoted), ':')))
+        return strtod(s + 1, NULL);
+    return def;
+}
+
 static void write_summary(struct coupler *c, enum mps_status st, const struct mps_err *err)
 {
     char path[4200];
@@ -548,6 +631,10 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_host_describe(host, sizeof host);
     mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", c->cs ? mps_case_path(c->cs) : "");
+    if (c->cs) {
+        mps_prov_json(c->cs, &j);
+        mps_json_num(&j, "end_time", mps_case_double(c->cs, "end_time"));
+    }
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");
     mps_json_str(&j, "failed_solver", c->failed_peer);
@@ -562,10 +649,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
         struct peer *p = &c->p[k];
         if (!p->needed)
             continue;
-        double compute = 0.0;
-        const char *s = p->bye ? strstr(p->bye, "\"compute_seconds\"") : NULL;
-        if (s && (s = strchr(s, ':')))
-            compute = strtod(s + 1, NULL);
+        double compute = bye_number(p, "compute_seconds", 0.0);
         mps_json_num(&j, p->name, compute);
         solvers += compute;
         msg += p->roundtrip_seconds - compute;
@@ -574,12 +658,17 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
     mps_json_num(&j, "coupler_other", wall - solvers - msg);
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
+    if (c->p[FLUID].bye) /* from the fluid's summary, as on the terminal */
+        mps_json_int(&j, "lost_particles",
+                     (long long)bye_number(&c->p[FLUID], "lost_particles", 0.0));
     mps_json_str(&j, "cpu_placement", c->cpu_note);
     if (c->motion) {
         mps_json_object(&j, "motion");
         mps_motion_summary(c->motion, &j);
         mps_json_close(&j);
     }
+    mps_json_str(&j, "transport", c->guard ? "tcp+curve" : "ipc");
+    guard_json(c->guard, &j); /* strangers turned away below the protocol */
     mps_json_object(&j, "solvers");
     for (int k = 0; k < NPEERS; k++) {
         struct peer *p = &c->p[k];
@@ -587,6 +676,7 @@ static void write_summary(struct coupler *c, enum mps_status st, const struct mp
             continue;
         mps_json_object(&j, p->name);
         mps_json_str(&j, "command", p->child.command);
+        mps_json_str(&j, "model", p->model); /* as its HELLO announced it */
         mps_json_str(&j, "endpoint", p->endpoint);
         mps_json_int(&j, "pid", (long long)p->child.pid);
         mps_json_int(&j, "exchanges", p->exchanges);
@@ -628,10 +718,14 @@ static void write_scene(struct coupler *c)
 
 static void cleanup(struct coupler *c)
 {
+    guard_destroy(&c->guard);
+    memset(&c->curve, 0, sizeof c->curve);
     for (int k = 0; k < NPEERS; k++) {
         proto_link_close(&c->p[k].sock);
         if (c->p[k].ipc_path[0])
             unlink(c->p[k].ipc_path);
+        if (c->p[k].key_path[0])
+            unlink(c->p[k].key_path);
         free(c->p[k].bye);
     }
     if (c->zctx)
@@ -645,13 +739,30 @@ static void cleanup(struct coupler *c)
     mps_case_destroy(&c->cs);
 }
 
+/* Refuses an option that names a solver the case does not need: it would
+ * otherwise be ignored without a word (exit 2). */
+static int refuse_unneeded(const struct coupler *c, const char *option, const char *value,
+                           int peer, const char *case_path)
+{
+    if (!value || c->p[peer].needed)
+        return 0;
+    fprintf(stderr, "coupler: %s %s: %s has no %s (%s), so no %s program runs; drop the option "
+                    "or choose a case with a %s\n",
+            option, value, case_path, c->p[peer].name,
+            peer == FLUID ? "fluid.tank" : "solid.bodies", c->p[peer].name, c->p[peer].name);
+    return 1;
+}
+
 int main(int argc, char **argv)
 {
+    mps_prov_init(argc, argv);
     struct mps_err err = {0};
     struct mps_cli cli;
     struct mps_cli_extra extra[] = {
-        {"--solid", 1, "solid program command (overrides the case key solid_solver)", NULL},
-        {"--fluid", 1, "fluid program command (overrides the case key fluid_solver)", NULL},
+        {"--solid", 1, "solid program command (sets the case key solid_solver; refused "
+                       "for a case without a solid)", NULL},
+        {"--fluid", 1, "fluid program command (sets the case key fluid_solver; refused "
+                       "for a case without a fluid)", NULL},
         {"--external", 1, "fluid|solid: do not launch it; wait for it to connect", NULL},
     };
     const char *usage =
@@ -670,8 +781,13 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
+    if (!cli.out_dir) {
+        /* no silent ./out: a second run there would mix with the first */
+        fprintf(stderr, "coupler: missing --out DIR (see --help)\n");
+        return 2;
+    }
     struct coupler c = {0};
-    c.out = cli.out_dir ? cli.out_dir : "out";
+    c.out = cli.out_dir;
     c.quiet = cli.quiet;
     c.wall0 = mps_wall_seconds();
     c.p[FLUID].name = "fluid";
@@ -679,7 +795,10 @@ int main(int argc, char **argv)
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
                                                  solid_case_keys, coupler_case_keys,
                                                  mps_motion_keys};
-    st = mps_case_load(&c.cs, cli.case_path, cli.sets, cli.nsets, tables, 5, NULL, &err);
+    c.tables = tables;
+    coupler_record_init(&c.rec, &cli, extra[0].value, extra[1].value);
+    st = mps_case_load(&c.cs, cli.case_path, c.rec.sets, c.rec.nsets, tables, NTABLES, NULL,
+                       &err);
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
         return mps_status_exit_code(st);
@@ -703,6 +822,13 @@ int main(int argc, char **argv)
         mps_case_destroy(&c.cs);
         return 2;
     }
+    if (refuse_unneeded(&c, "--solid", extra[0].value, SOLID, cli.case_path) ||
+        refuse_unneeded(&c, "--fluid", extra[1].value, FLUID, cli.case_path) ||
+        refuse_unneeded(&c, "--external", ext, ext && !strcmp(ext, "solid") ? SOLID : FLUID,
+                        cli.case_path)) {
+        mps_case_destroy(&c.cs);
+        return 2;
+    }
 
     /* The solvers' cross-key checks (a block outside the tank, an empty clamp,
      * ...) run here too, so an error names the user's file or --set, not the
@@ -716,6 +842,8 @@ int main(int argc, char **argv)
             st = fluid_params_read(&fp, c.cs, &err);
         if (!st && sc)
             st = solid_scene_read(sc, c.cs, &err);
+        if (!st && sc && c.p[FLUID].needed)
+            st = scene_check_fsi(&fp, sc, c.cs, &err);
         if (!st)
             st = mps_motion_read(&c.motion, c.cs, &err);
         free(sc);
@@ -727,7 +855,7 @@ int main(int argc, char **argv)
         }
     }
 
-    char resolved[4200];
+    const char *resolved = c.rec.path;
     if ((st = mps_mkdir_p(c.out, &err)))
         goto end;
     {
@@ -736,9 +864,11 @@ int main(int argc, char **argv)
             st = mps_err_set(&err, MPS_EIO, "%s: %s", c.out, strerror(errno));
             goto end;
         }
-        snprintf(resolved, sizeof resolved, "%s/case_resolved.yml", abs_out);
+        snprintf(c.rec.path, sizeof c.rec.path, "%s/case_resolved.yml", abs_out);
     }
-    if ((st = mps_case_write_resolved(c.cs, resolved, &err)))
+    /* written now, so a run that fails to start leaves it too; rewritten as
+     * each solver says hello (coupler_record_hello) */
+    if ((st = coupler_record_write(&c.rec, c.cs, &err)))
         goto end;
     snprintf(c.rundir, sizeof c.rundir, "/tmp/mpsfsi-XXXXXX");
     if (!mkdtemp(c.rundir)) {
@@ -763,19 +893,30 @@ int main(int argc, char **argv)
         if ((st = open_endpoint(&c, k, &err)))
             goto end;
         p->active = 1; /* listened to from now on */
-        const char *cmd = extra[k == FLUID ? 1 : 0].value;
-        if (!cmd)
-            cmd = mps_case_string(c.cs, k == FLUID ? "fluid_solver" : "solid_solver");
+    }
+    /* every socket holds its copy of the server's secret key now */
+    memset(c.curve.server_secret, 0, sizeof c.curve.server_secret);
+    /* the ZAP handler answers before any solver is launched */
+    if (c.guard && (st = guard_start(c.guard, stderr, &err)))
+        goto end;
+    for (int k = 0; k < NPEERS; k++) {
+        struct peer *p = &c.p[k];
+        if (!p->needed)
+            continue;
+        /* --solid/--fluid are already in the case (coupler_record_init) */
+        const char *cmd = mps_case_string(c.cs, k == FLUID ? "fluid_solver" : "solid_solver");
         snprintf(p->child.command, sizeof p->child.command, "%s", cmd);
-        if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint, &err)))
+        if (!p->external && (st = launch_start(&p->child, p->name, cmd, p->endpoint,
+                                               p->key_path[0] ? p->key_path : NULL, &err)))
             goto end;
         p->child.name = p->name;
     }
     /* one solver at a time, so the only message that can come unasked is an
-     * ERROR */
-    for (int k = 0; k < NPEERS; k++)
-        if (c.p[k].needed &&
-            ((st = handshake(&c, k, resolved, &err)) || (st = await_ready(&c, k, &err))))
+     * ERROR; the solid first, so the model its HELLO names is in the case
+     * file before the fluid reads it (coupler_record_hello) */
+    for (int q = NPEERS - 1; q >= 0; q--)
+        if (c.p[q].needed &&
+            ((st = handshake(&c, q, resolved, &err)) || (st = await_ready(&c, q, &err))))
             goto end;
     if ((st = open_probes(&c, &err)))
         goto end;
@@ -794,9 +935,22 @@ end:
         for (int k = 0; k < NPEERS; k++)
             launch_reap(&c.p[k].child, 10.0);
     }
+    if (c.guard) {
+        guard_stop(c.guard);
+        char who[512];
+        guard_describe(c.guard, who, sizeof who);
+        if (who[0])
+            fprintf(stderr, "coupler: refused %ld unauthenticated connection%s: %s\n",
+                    guard_refused(c.guard), guard_refused(c.guard) == 1 ? "" : "s", who);
+    }
     if (c.cs && c.out) {
         write_summary(&c, st, &err);
         write_scene(&c);
+        long lost = (long)bye_number(&c.p[FLUID], "lost_particles", 0);
+        if (lost > 0) /* a result, not progress: --quiet keeps it */
+            fprintf(stderr, "coupler: %ld fluid particle%s left over the open tank walls "
+                            "(removed; lost_particles in summary.json)\n",
+                    lost, lost == 1 ? "" : "s");
     }
     cleanup(&c);
     return mps_status_exit_code(st);

@@ -13,6 +13,9 @@ const struct mps_key_spec coupler_case_keys[] = {
      "first port for tcp transport (fluid: port, solid: port + 1)"},
     {"coupling.tcp_host", MPS_KEY_STRING, "127.0.0.1", 0, 0, 0, NULL, "",
      "address the solvers connect to with tcp transport"},
+    {"coupling.tcp_bind", MPS_KEY_STRING, "127.0.0.1", 0, 0, 0, NULL, "",
+     "address the coupler listens on with tcp transport (an interface's address, or * for "
+     "every interface); connections are authenticated with CURVE either way"},
     {"coupling.pin_cpus", MPS_KEY_ENUM, "auto", 0, 0, 0, "auto|off", "",
      "auto: the coupler and the solvers' main threads share one CPU (cheaper messages), "
      "OpenMP workers take the others; off: the OS places them"},

@@ -15,6 +15,8 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "proto_key.h"
+
 #define MAX_WORDS 64
 
 /* Splits on blanks; single or double quotes group words (no escapes). */
@@ -119,7 +121,7 @@ int launch_share_cpu(int want, char *note, size_t len)
 }
 
 enum mps_status launch_start(struct child *c, const char *name, const char *command,
-                             const char *endpoint, struct mps_err *err)
+                             const char *endpoint, const char *key_file, struct mps_err *err)
 {
     memset(c, 0, sizeof *c);
     c->name = name;
@@ -168,6 +170,12 @@ enum mps_status launch_start(struct child *c, const char *name, const char *comm
             setenv("OMP_PLACES", shared.places, 0);
             setenv("OMP_PROC_BIND", "close", 0);
         }
+        /* the run's key (PROTOCOL.md section 10); an inherited one is not
+         * this run's */
+        if (key_file)
+            setenv(PROTO_KEY_ENV, key_file, 1);
+        else
+            unsetenv(PROTO_KEY_ENV);
         execvp(words[0], words);
         fprintf(stderr, "coupler: cannot start the %s solver '%s': %s\n", name, words[0],
                 strerror(errno));

@@ -30,9 +30,11 @@ struct child {
  * and why. */
 int launch_share_cpu(int want, char *note, size_t len);
 
-/* Launches `command --connect endpoint [--timeout S]`. */
+/* Launches `command --connect endpoint`. key_file (NULL: none) reaches the
+ * solver as PROTO_KEY_ENV in its environment, never on its command line,
+ * which every user can read in ps. */
 enum mps_status launch_start(struct child *c, const char *name, const char *command,
-                             const char *endpoint, struct mps_err *err);
+                             const char *endpoint, const char *key_file, struct mps_err *err);
 
 /* Reaps the child if it has exited (non-blocking). Returns 1 if it has
  * exited (now or before), 0 if still running or never launched. */

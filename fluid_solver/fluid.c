@@ -28,6 +28,10 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "velocity", MPS_DIM, MPS_F64, (void **)&f->v, "m/s", 1);
     mps_particles_add_field(ps, "pressure", 1, MPS_F64, (void **)&f->p, "Pa", 1);
     mps_particles_add_field(ps, "type", 1, MPS_I32, (void **)&f->type, "", 1);
+    /* the codes of enum fluid_ptype that snapshots hold: a coupled solid's
+     * particles (3, 4) are written by the solid (fluid_solver/main.c) */
+    mps_particles_set_legend(ps, "type", "0 fluid, 1 wall (first layer), 2 dummy (outer wall "
+                                         "layers)");
     mps_particles_add_field(ps, "id", 1, MPS_I32, (void **)&f->id, "", 1);
     mps_particles_add_field(ps, "number_density", 1, MPS_F64, (void **)&f->nd, "", 1);
     mps_particles_add_field(ps, "free_surface", 1, MPS_U8, (void **)&f->surface, "", 1);
@@ -275,6 +279,7 @@ static enum mps_status build_neighbours(struct fluid *f, struct mps_err *err)
     if (st || (st = reorder_fluid(f, err)))
         return st;
     f->nbr_rebuilds++;
+    f->last.neighbour_build = 1;
     memcpy(f->xref, f->x, f->ps.n * sizeof *f->x);
     st = mps_nbr_list_build_masked(&f->nl, &f->grid, (const double(*)[MPS_DIM])f->x, f->ps.n,
                                    f->nbr_query, radius, err);
@@ -313,15 +318,16 @@ static enum mps_status update_neighbours(struct fluid *f, struct mps_err *err)
  * given restitution (Koshizuka's collision model; fixed and solid particles
  * act as infinitely heavy). Computed from a frozen copy so the result does
  * not depend on loop order. */
-static void collide(struct fluid *f, double dt)
+static long collide(struct fluid *f, double dt)
 {
     const double cd = f->prm.collision_dist * f->prm.dp, cd2 = cd * cd;
     const double e = f->prm.collision_restitution;
+    long pairs = 0;
     if (cd <= 0.0)
-        return;
+        return 0;
     double(*vs)[MPS_DIM] = f->vstar;
     double(*dv)[MPS_DIM] = f->grad; /* scratch: grad is recomputed later */
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) reduction(+ : pairs)
     for (size_t i = 0; i < f->nfluid; i++) {
         double acc[MPS_DIM] = {0};
         for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
@@ -342,6 +348,7 @@ static void collide(struct fluid *f, double dt)
                 continue; /* separating */
             /* equal masses share the impulse; a fixed partner takes none */
             double share = f->is_fluid[j] ? 0.5 : 1.0;
+            pairs++;
             for (int d = 0; d < MPS_DIM; d++)
                 acc[d] -= share * (1.0 + e) * vn * dx[d] / r;
         }
@@ -354,6 +361,7 @@ static void collide(struct fluid *f, double dt)
             vs[i][d] += dv[i][d];
             f->x[i][d] += dt * dv[i][d];
         }
+    return pairs;
 }
 
 /* Particle shifting (Lind et al. 2012, with Skillen et al. 2013's scaling and
@@ -585,6 +593,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
                            "flow is too fast for the CFL condition (Eq. 52)",
                            dt, f->time, p->dt_min);
 
+    f->last = (struct fluid_step_stats){.dt = dt};
     /* body force at the step's middle (a moving tank's changes in time) */
     mps_timer_switch(&f->timer, PH_PREDICT);
     fluid_body_accel(f, f->time + 0.5 * dt);
@@ -613,7 +622,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     if ((st = mps_nbr_list_filter(&f->nl_n, &f->nl, x, p->re_n * p->dp, err)))
         return st;
     mps_timer_switch(&f->timer, PH_PREDICT);
-    collide(f, dt);
+    f->last.collisions = collide(f, dt);
 
     /* Eq. 8 at x*, and the free-surface double check (paper 4.3), for the
      * PPE unknowns (f->unknown: which they are depends on fluid.wall_bc) */
@@ -653,6 +662,13 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     if (st)
         return st;
     f->ppe_iterations += ls.iterations;
+    f->last.ppe_iterations = ls.iterations;
+    f->last.ppe_rows = f->nrows;
+    int at_zero = 0;
+#pragma omp parallel for schedule(static) reduction(+ : at_zero)
+    for (size_t i = 0; i < n; i++)
+        at_zero += f->row[i] >= 0 && f->p[i] <= 0.0;
+    f->last.rows_at_zero = at_zero;
 
     /* Eq. 14-15 (or 9), Eq. 19 and 24 */
     mps_timer_switch(&f->timer, PH_CORRECT);

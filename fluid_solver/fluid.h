@@ -30,6 +30,16 @@ enum fluid_phase {
     PH_NBR, PH_PREDICT, PH_DENSITY, PH_ASSEMBLE, PH_SOLVE, PH_CORRECT, PH_OTHER, PH_COUNT
 };
 
+/* What the last step did, for the step log (fluid.step_log). */
+struct fluid_step_stats {
+    double dt;
+    int ppe_iterations;
+    int ppe_rows;
+    int rows_at_zero;      /* PPE rows whose pressure came out <= 0 (clamped) */
+    long collisions;       /* pair impulses of the collision model */
+    int neighbour_build;   /* 1 if the neighbour list was rebuilt */
+};
+
 struct fluid {
     struct fluid_params prm;
     struct mps_particles ps;
@@ -96,6 +106,7 @@ struct fluid {
     long nbr_rebuilds;
     long lost;             /* fluid particles that splashed out of an open tank */
     long wall_guard;       /* times a particle was put back inside the tank */
+    struct fluid_step_stats last;
     struct mps_timer timer;
 };
 

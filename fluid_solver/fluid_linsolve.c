@@ -884,6 +884,16 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
     if ((rc = first_direction(s, A, x, &rr, &rz, err)))
         return rc;
     while (it < s->max_iter) {
+        if (rr <= tol2) {
+            /* the deflated start can solve a small system outright (every
+             * row its own aggregate: a few drops of water), leaving p = 0
+             * and nothing to iterate on */
+            k_residual(s, s->nthreads, A, b, x, r, rb);
+            if ((rr = rb[0]) <= tol2) {
+                converged = 1;
+                break;
+            }
+        }
         double pq = k_spmv_dot(s, A, p, q);
         it++;
         if (!(pq > 0.0) || !(rz > 0.0)) {

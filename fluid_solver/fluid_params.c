@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "mps_budget.h"
+
 #define NOHI (MPS_KEY_NO_HI)
 #define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
 
@@ -21,6 +23,11 @@ const struct mps_key_spec fluid_case_keys[] = {
      "smallest step the CFL condition may ask for before the run is declared diverged"},
     {"fluid.kappa", MPS_KEY_DOUBLE, "0.01", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "relaxation of the PPE source term (Eq. 23)"},
+    {"fluid.kappa_rate", MPS_KEY_ENUM, "fixed", 0, 0, 0, "fixed|per_step", "",
+     "how Eq. 23's kappa scales with the step: per_step is Eq. 23 as printed, a fraction kappa "
+     "of the density error corrected every step (its source and pressure scale as 1/dt^2 when "
+     "the step changes); fixed corrects kappa dt / dt_max per step, a fixed rate kappa / "
+     "fluid.dt_max (the two agree at dt = dt_max; docs/pressure.md)"},
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
@@ -74,6 +81,9 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.ppe_coarse_cell", MPS_KEY_DOUBLE, "4", 1, 100, 0, NULL, "dp",
      "pcg_defl: side of the square cells whose PPE rows form one aggregate of the coarse "
      "space (docs/ppe_solvers.md)"},
+    {"fluid.step_log", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
+     "write PREFIX_steps.csv: one row per step (dt, PPE iterations and rows, rows at P = 0, "
+     "collision pairs, neighbour-list builds), for diagnosing a run"},
     /* not REQUIRED in the schema: a solid-only case has no tank; the fluid
      * checks for it in fluid_params_read */
     {"fluid.tank.width", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "m",
@@ -128,6 +138,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->dt_max = mps_case_double(c, "fluid.dt_max");
     p->dt_min = mps_case_double(c, "fluid.dt_min");
     p->kappa = mps_case_double(c, "fluid.kappa");
+    p->kappa_fixed_rate = strcmp(mps_case_string(c, "fluid.kappa_rate"), "fixed") == 0;
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
     p->initial_hydrostatic =
@@ -153,6 +164,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->shift_coef = mps_case_double(c, "fluid.shifting");
     p->shift_max = mps_case_double(c, "fluid.shifting_max");
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");
+    p->step_log = mps_case_bool(c, "fluid.step_log");
     p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");
     p->ppe_max_iter = (int)mps_case_int(c, "fluid.ppe_max_iter");
     p->ppe_drop = mps_case_double(c, "fluid.ppe_drop");
@@ -185,6 +197,10 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     for (int b = 0; b < p->nblocks; b++) {
         static const char *const names[4] = {"x0", "y0", "x1", "y1"};
         char key[64];
+        snprintf(key, sizeof key, "fluid.blocks.%d.x0", b);
+        if (!mps_case_has(c, "%s", key)) /* an item given by --set past the end */
+            return mps_err_set(err, MPS_EINPUT, "%s: fluid.blocks.%d: missing (a gap in the "
+                               "list of blocks)", mps_case_path(c), b);
         for (int k = 0; k < 4; k++)
             p->block[b][k] = mps_case_double(c, "fluid.blocks.%d.%s", b, names[k]);
         snprintf(key, sizeof key, "fluid.blocks.%d.x1", b);
@@ -209,7 +225,31 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
         }
         if (p->block[b][3] > top)
             top = p->block[b][3];
+        /* overlapping blocks would put two particles on one lattice site */
+        const double *q = p->block[b];
+        for (int a = 0; a < b; a++) {
+            const double *o = p->block[a];
+            if (fmin(q[2], o[2]) - fmax(q[0], o[0]) > tol &&
+                fmin(q[3], o[3]) - fmax(q[1], o[1]) > tol) {
+                snprintf(key, sizeof key, "fluid.blocks.%d.x0", b);
+                return mps_case_fail(c, err, key,
+                                     "the water block overlaps fluid.blocks.%d ([%g, %g] x "
+                                     "[%g, %g]): split them so each place holds water once",
+                                     a, o[0], o[2], o[1], o[3]);
+            }
+        }
     }
+
+    /* Before anything is allocated: water blocks and wall layers round the
+     * tank (an upper bound: blocks may overlap). */
+    double water = 0.0;
+    for (int b = 0; b < p->nblocks; b++)
+        water += (p->block[b][2] - p->block[b][0]) * (p->block[b][3] - p->block[b][1]);
+    double nparticles = water / (p->dp * p->dp) +
+                        (p->wall_layers + 1.0) * 2.0 * (p->tank_w + p->tank_h) / p->dp;
+    enum mps_status st = mps_budget_check(c, "dp", "fluid", nparticles, MPS_BUDGET_FLUID_BYTES, err);
+    if (st)
+        return st;
 
     /* The CFL cap must be satisfiable: a column of height H reaches about
      * sqrt(2 g H) on collapse, so the CFL step is C dp / sqrt(2 g H). */
@@ -226,6 +266,9 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
         return mps_case_fail(c, err, "fluid.probes", "%d probes: at most %d", p->nprobes,
                              FLUID_MAX_PROBES);
     for (int k = 0; k < p->nprobes; k++) {
+        if (!mps_case_has(c, "fluid.probes.%d.name", k))
+            return mps_err_set(err, MPS_EINPUT, "%s: fluid.probes.%d: missing (a gap in the "
+                               "list of probes)", mps_case_path(c), k);
         p->probes[k].name = mps_case_string(c, "fluid.probes.%d.name", k);
         p->probes[k].kind = probe_kind(mps_case_string(c, "fluid.probes.%d.kind", k));
         p->probes[k].x = mps_case_double(c, "fluid.probes.%d.x", k);

@@ -43,6 +43,7 @@ struct fluid_params {
     int mixed_source;             /* add the velocity-divergence source term */
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
+    int kappa_fixed_rate;         /* kappa per dt_max (rate kappa/dt_max), not per step */
     double re_n, re_lap;          /* effective radii, multiples of dp */
     double beta1, beta2;          /* free-surface double check */
     double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */
@@ -55,6 +56,7 @@ struct fluid_params {
     double collision_restitution;
     double shift_coef, shift_max; /* particle shifting: A (0 = off), cap in dp */
     const char *ppe_solver;
+    int step_log;                 /* write PREFIX_steps.csv */
     double ppe_rtol;
     int ppe_max_iter;
     double ppe_drop;       /* pcg_sic0 drop threshold */

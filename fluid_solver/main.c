@@ -19,6 +19,7 @@
 #include "mps_omp.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
+#include "mps_prov.h"
 #include "mps_simd.h"
 #include "mps_timer.h"
 #include "mps_version.h"
@@ -37,6 +38,7 @@ struct run {
     struct fluid *f;
     struct mps_h5_series *h5;
     struct mps_probes *probes;
+    struct mps_probes *steps;   /* fluid.step_log */
     const char *out;
     double wall0, t_output;
     int quiet;
@@ -52,12 +54,16 @@ struct run {
     char cpu_note[96];   /* what mps_omp_bind_threads did (standalone runs) */
 };
 
+/* The fluid and its tank, [0, nfixed_end): a coupled solid's particles, the
+ * segment after them, are the solid's to write (its own snapshots carry them
+ * with their own ids and fields); written here too they would repeat its ids
+ * and show twice in scene.xmf. */
 static enum mps_status write_snapshot(struct run *r, struct mps_err *err)
 {
     double t0 = mps_wall_seconds();
     struct mps_field fields[MPS_PARTICLES_MAX_FIELDS];
     int nf = fluid_output_fields(r->f, fields, MPS_PARTICLES_MAX_FIELDS);
-    enum mps_status st = mps_h5_write(r->h5, r->f->time, r->f->step, r->f->ps.n,
+    enum mps_status st = mps_h5_write(r->h5, r->f->time, r->f->step, r->f->nfixed_end,
                                       (const double(*)[MPS_DIM])r->f->x, fields, nf, err);
     r->t_output += mps_wall_seconds() - t0;
     return st;
@@ -69,6 +75,17 @@ static enum mps_status write_probes(struct run *r, struct mps_err *err)
     for (int k = 0; k < r->f->prm.nprobes; k++)
         v[k] = fluid_probe(r->f, k);
     return mps_probes_write(r->probes, r->f->time, v, err);
+}
+
+/* One row of the step log (fluid.step_log), after each step. */
+static enum mps_status write_step_row(struct run *r, struct mps_err *err)
+{
+    if (!r->steps)
+        return MPS_OK;
+    const struct fluid_step_stats *l = &r->f->last;
+    double v[6] = {l->dt, l->ppe_iterations, l->ppe_rows, l->rows_at_zero,
+                   (double)l->collisions, l->neighbour_build};
+    return mps_probes_write(r->steps, r->f->time, v, err);
 }
 
 static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
@@ -83,6 +100,10 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
     mps_host_describe(host, sizeof host);
     mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", r->cs ? mps_case_path(r->cs) : "");
+    if (r->cs) {
+        mps_prov_json(r->cs, &j);
+        mps_json_num(&j, "end_time", mps_case_double(r->cs, "end_time"));
+    }
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");
     mps_json_num(&j, "wall_seconds", mps_wall_seconds() - r->wall0);
@@ -128,11 +149,15 @@ static char *write_summary(const struct run *r, enum mps_status st, const struct
     return text;
 }
 
-/* The next step: the CFL step, shortened so output times are hit exactly and
- * no sliver of a step is left before them. */
-static double next_dt(const struct fluid *f, double t_next)
+/* The next step: the CFL step, shortened only to end the run at end_time
+ * with no sliver of a step left before it. Output and probe times do not
+ * shorten steps: a snapshot or probe row is written at the end of the first
+ * step that reaches its time, and records that step's time, so the output
+ * schedule never changes the solution (docs/pressure.md: shortened steps
+ * made the pressure flicker). */
+static double next_dt(const struct fluid *f, double t_end)
 {
-    double dt = fluid_cfl_dt(f), left = t_next - f->time;
+    double dt = fluid_cfl_dt(f), left = t_end - f->time;
     if (left <= dt * (1.0 + 1e-9))
         return left;
     if (left < 2.0 * dt)
@@ -157,8 +182,8 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
             return mps_err_set(err, MPS_EINTR, "interrupted by signal %d at t = %.6g s",
                                (int)stop_signal, r->f->time);
         double t_out = p->output_interval > 0.0 ? out_k * p->output_interval : INFINITY;
-        double t_next = fmin(t_out, p->end_time);
-        if ((st = fluid_step(r->f, next_dt(r->f, t_next), err)))
+        if ((st = fluid_step(r->f, next_dt(r->f, p->end_time), err)) ||
+            (st = write_step_row(r, err)))
             return st;
         if (r->f->time >= probe_k * p->probe_interval - eps) {
             if ((st = write_probes(r, err)))
@@ -169,7 +194,8 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
         if (r->f->time >= t_out - eps) {
             if ((st = write_snapshot(r, err)))
                 return st;
-            out_k++;
+            while (out_k * p->output_interval <= r->f->time + eps)
+                out_k++;
         }
         mps_progress_update(&prog, r->f->time, r->f->step);
     }
@@ -185,8 +211,15 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
                                                  mps_motion_keys};
     const char *const ignore[] = {"solid.", "coupling.", NULL};
-    enum mps_status st =
-        mps_case_load(&r->cs, case_path, sets, nsets, tables, 3, ignore, err);
+    /* standalone: this command is the run's record; under the coupler the
+     * resolved case brings the coupler's */
+    const char *all[MPS_CLI_MAX_SETS + MPS_PROV_NSETS];
+    int nall = 0;
+    for (int k = 0; k < nsets; k++)
+        all[nall++] = sets[k];
+    if (!r->coupled)
+        mps_prov_sets(all, &nall, MPS_CLI_MAX_SETS + MPS_PROV_NSETS);
+    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, tables, 3, ignore, err);
     struct fluid_params prm;
     if (st || (st = fluid_params_read(&prm, r->cs, err)) ||
         (st = mps_motion_read(&r->motion, r->cs, err)) || (st = mps_mkdir_p(r->out, err)))
@@ -204,8 +237,19 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
     st = mps_h5_open(&r->h5, r->out, prefix, "fluid_solver", yaml ? yaml : "", err);
     free(yaml);
     /* under the coupler, probes travel in RESULT and the coupler writes them */
-    if (!st && !r->coupled)
-        st = mps_probes_open(&r->probes, path, names, prm.nprobes, err);
+    if (!st && !r->coupled) {
+        char *comment = mps_prov_comment(r->cs, "fluid_solver");
+        st = mps_probes_open(&r->probes, path, comment, names, prm.nprobes, err);
+        free(comment);
+    }
+    if (!st && prm.step_log) {
+        static const char *const cols[6] = {"dt", "ppe_iterations", "ppe_rows",
+                                            "rows_at_zero", "collision_pairs", "neighbour_build"};
+        snprintf(path, sizeof path, "%s/%s_steps.csv", r->out, prefix);
+        char *comment = mps_prov_comment(r->cs, "fluid_solver");
+        st = mps_probes_open(&r->steps, path, comment, cols, 6, err);
+        free(comment);
+    }
     return st;
 }
 
@@ -246,6 +290,8 @@ static enum mps_status peer_advance(void *self, const struct proto_msg *in,
         return st;
     /* the coupler's clock is the reference: no drift from summing steps */
     f->time = in->time + in->dt;
+    if ((st = write_step_row(r, err)))
+        return st;
     if (in->count > r->load_cap) {
         size_t cap = in->count + 64;
         int *id = realloc(r->load_id, cap * sizeof *id);
@@ -289,6 +335,7 @@ static char *peer_finish(void *self, enum mps_status st, const struct mps_err *e
 static void teardown(struct run *r)
 {
     mps_probes_close(&r->probes);
+    mps_probes_close(&r->steps);
     mps_h5_close(&r->h5);
     fluid_destroy(&r->f);
     mps_motion_destroy(&r->motion);
@@ -316,6 +363,7 @@ static int run_coupled(const char *endpoint, int hello_timeout_ms)
 int main(int argc, char **argv)
 {
     struct mps_err err = {0};
+    mps_prov_init(argc, argv);
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     const char *endpoint = NULL;
@@ -341,8 +389,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "fluid_solver: %s\n", err.msg);
         return mps_status_exit_code(st);
     }
-    struct run r = {.out = cli.out_dir ? cli.out_dir : "out", .quiet = cli.quiet,
-                    .summary_name = "summary.json"};
+    if (!cli.out_dir) {
+        /* no silent ./out: a second run there would mix with the first */
+        fprintf(stderr, "fluid_solver: missing --out DIR (see --help)\n");
+        return 2;
+    }
+    struct run r = {.out = cli.out_dir, .quiet = cli.quiet, .summary_name = "summary.json"};
     r.wall0 = mps_wall_seconds();
     mps_omp_bind_threads(r.cpu_note, sizeof r.cpu_note);
     st = setup(&r, cli.case_path, cli.sets, cli.nsets, "fluid", &err);
@@ -364,6 +416,10 @@ int main(int argc, char **argv)
     if (st)
         fprintf(stderr, "%sfluid_solver: %s: %s\n", r.f && r.f->step ? "\n" : "",
                 mps_status_name(st), err.msg);
+    if (r.f && r.f->lost > 0) /* a result, not progress: --quiet keeps it */
+        fprintf(stderr, "fluid_solver: %ld fluid particle%s left over the open tank walls "
+                        "(removed; lost_particles in summary.json)\n",
+                r.f->lost, r.f->lost == 1 ? "" : "s");
     if (r.f) /* a run that started leaves its summary, even a failed one */
         free(write_summary(&r, st, &err));
     teardown(&r);

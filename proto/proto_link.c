@@ -16,8 +16,41 @@ static enum mps_status zfail(struct mps_err *err, const char *what, const char *
                        endpoint ? endpoint : "", zmq_strerror(e));
 }
 
+/* CURVE options, set before bind/connect. 0 or -1 (zmq_errno set). */
+static int set_curve(void *s, enum proto_link_mode mode, const struct proto_curve *k,
+                     const char *zap_domain)
+{
+    int hs = PROTO_HANDSHAKE_MS;
+    if (zmq_setsockopt(s, ZMQ_HANDSHAKE_IVL, &hs, sizeof hs) != 0)
+        return -1;
+    if (mode == PROTO_LINK_BIND) {
+        int on = 1;
+        const char *dom = zap_domain ? zap_domain : "";
+        return zmq_setsockopt(s, ZMQ_CURVE_SERVER, &on, sizeof on) != 0 ||
+                       zmq_setsockopt(s, ZMQ_CURVE_SECRETKEY, k->server_secret,
+                                      PROTO_KEY_Z85) != 0 ||
+                       zmq_setsockopt(s, ZMQ_ZAP_DOMAIN, dom, strlen(dom)) != 0
+                   ? -1
+                   : 0;
+    }
+    return zmq_setsockopt(s, ZMQ_CURVE_SERVERKEY, k->server_public, PROTO_KEY_Z85) != 0 ||
+                   zmq_setsockopt(s, ZMQ_CURVE_PUBLICKEY, k->client_public, PROTO_KEY_Z85) !=
+                       0 ||
+                   zmq_setsockopt(s, ZMQ_CURVE_SECRETKEY, k->client_secret, PROTO_KEY_Z85) != 0
+               ? -1
+               : 0;
+}
+
 enum mps_status proto_link_open(void *zctx, enum proto_link_mode mode, const char *endpoint,
                                 void **sock, struct mps_err *err)
+{
+    return proto_link_open_secure(zctx, mode, endpoint, NULL, NULL, sock, err);
+}
+
+enum mps_status proto_link_open_secure(void *zctx, enum proto_link_mode mode,
+                                       const char *endpoint, const struct proto_curve *curve,
+                                       const char *zap_domain, void **sock,
+                                       struct mps_err *err)
 {
     *sock = NULL;
     if (!zctx || !endpoint)
@@ -34,6 +67,11 @@ enum mps_status proto_link_open(void *zctx, enum proto_link_mode mode, const cha
     if (zmq_setsockopt(s, ZMQ_LINGER, &linger, sizeof linger) != 0 ||
         zmq_setsockopt(s, ZMQ_SNDTIMEO, &sndtimeo, sizeof sndtimeo) != 0) {
         enum mps_status st = zfail(err, "zmq_setsockopt on", endpoint);
+        zmq_close(s);
+        return st;
+    }
+    if (curve && set_curve(s, mode, curve, zap_domain) != 0) {
+        enum mps_status st = zfail(err, "setting CURVE keys on", endpoint);
         zmq_close(s);
         return st;
     }

@@ -6,6 +6,7 @@
 #define PROTO_LINK_H
 
 #include "mps_err.h"
+#include "proto_key.h"
 #include "proto_msg.h"
 
 #define PROTO_LINGER_MS 1000          /* last messages still leave; close never hangs */
@@ -23,6 +24,18 @@ enum proto_link_mode {
  * MPS_ELIB. *sock is NULL on failure. */
 enum mps_status proto_link_open(void *zctx, enum proto_link_mode mode, const char *endpoint,
                                 void **sock, struct mps_err *err);
+
+/* The same with CURVE security (PROTOCOL.md section 10) when curve is not
+ * NULL. BIND: a CURVE server with curve->server_secret whose connections are
+ * authenticated by the ZAP handler under zap_domain (the caller must run one
+ * before it binds: without a handler libzmq accepts any client key).
+ * CONNECT: a CURVE client with curve->server_public and the client pair.
+ * Handshakes that do not finish within PROTO_HANDSHAKE_MS are dropped. */
+#define PROTO_HANDSHAKE_MS 5000
+enum mps_status proto_link_open_secure(void *zctx, enum proto_link_mode mode,
+                                       const char *endpoint, const struct proto_curve *curve,
+                                       const char *zap_domain, void **sock,
+                                       struct mps_err *err);
 
 /* Closes the socket (linger applies) and sets *sock = NULL; NULL ok. */
 void proto_link_close(void **sock);

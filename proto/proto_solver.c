@@ -72,7 +72,25 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
     struct proto_msg in = {0}, reply;
     int configured = 0, said_error = 0;
     long timeout_ms = 1800000;
-    enum mps_status st = proto_link_open(ctx, PROTO_LINK_CONNECT, endpoint, &sock, err);
+    /* tcp is authenticated with CURVE (PROTOCOL.md section 10); ipc lives in
+     * the coupler's private run directory */
+    struct proto_curve keys, *curve = NULL;
+    enum mps_status st = MPS_OK;
+    if (strncmp(endpoint, "tcp://", 6) == 0) {
+        const char *kf = getenv(PROTO_KEY_ENV);
+        if (!kf || !kf[0]) {
+            st = mps_err_set(err, MPS_EINPUT,
+                             "%s: a tcp endpoint needs the run's key: --key FILE (or %s=FILE "
+                             "in the environment; PROTOCOL.md section 10)",
+                             endpoint, PROTO_KEY_ENV);
+            goto done;
+        }
+        if ((st = proto_key_read(kf, &keys, err)))
+            goto done;
+        curve = &keys;
+    }
+    st = proto_link_open_secure(ctx, PROTO_LINK_CONNECT, endpoint, curve, NULL, &sock, err);
+    memset(&keys, 0, sizeof keys); /* the socket holds its copy */
     if (st)
         goto done;
 
@@ -228,11 +246,24 @@ int proto_solver_args(int argc, char **argv, const char **endpoint, int *hello_t
             }
             *hello_timeout_ms = (int)(s * 1000.0);
             i++;
+        } else if (strcmp(argv[i], "--key") == 0) {
+            if (i + 1 >= argc || !argv[i + 1][0]) {
+                mps_err_set(err, MPS_EINPUT, "--key needs a key file (PROTOCOL.md section 10)");
+                return -1;
+            }
+            /* one way in for the key file, whoever started us: the
+             * environment variable the coupler sets for the solvers it
+             * launches (the key itself never goes on a command line) */
+            if (setenv(PROTO_KEY_ENV, argv[++i], 1) != 0) {
+                mps_err_set(err, MPS_ENOMEM, "--key: cannot set %s", PROTO_KEY_ENV);
+                return -1;
+            }
         } else if (strcmp(argv[i], "--quiet") == 0) {
             continue;
         } else if (found) {
             mps_err_set(err, MPS_EINPUT,
-                        "'%s': a coupled solver takes only --connect, --timeout and --quiet "
+                        "'%s': a coupled solver takes only --connect, --key, --timeout and "
+                        "--quiet "
                         "(the case comes from the coupler)",
                         argv[i]);
             return -1;

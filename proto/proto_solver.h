@@ -52,8 +52,9 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
                                  volatile const int *stop_flag, struct proto_solver_stats *stats,
                                  struct mps_err *err);
 
-/* Solver programs run coupled as `PROGRAM --connect ENDPOINT [--timeout S]
- * [--quiet]`. Returns 1 and fills endpoint / hello_timeout_ms if argv holds
+/* Solver programs run coupled as `PROGRAM --connect ENDPOINT [--key FILE]
+ * [--timeout S] [--quiet]`. --key FILE sets PROTO_KEY_ENV (proto_key.h),
+ * where proto_solver_run looks for the key of a tcp endpoint. Returns 1 and fills endpoint / hello_timeout_ms if argv holds
  * --connect, 0 if not, -1 (err set) if the coupled arguments are malformed. */
 int proto_solver_args(int argc, char **argv, const char **endpoint, int *hello_timeout_ms,
                       struct mps_err *err);

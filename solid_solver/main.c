@@ -2,7 +2,10 @@
  *   solid_solver CASE.yml --out DIR [--set key=value]... [--quiet] [--model NAME]
  * Steps the chosen model with its own stable step up to end_time, landing
  * exactly on every snapshot and probe time, and writes DIR/solid_*.h5 +
- * solid.xmf, DIR/probes.csv and DIR/summary.json. */
+ * solid.xmf, DIR/probes.csv and DIR/summary.json.
+ *   solid_solver [--model NAME] --connect ENDPOINT [--timeout S]
+ * runs under the coupler (proto/PROTOCOL.md, solid_peer.c). --model NAME is
+ * --set solid.model=NAME, so the files record the model that ran. */
 #include <math.h>
 #include <signal.h>
 #include <stdio.h>
@@ -16,6 +19,7 @@
 #include "mps_json.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
+#include "mps_prov.h"
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_solver.h"
@@ -25,7 +29,10 @@
 
 static const char usage[] =
     "usage: solid_solver CASE.yml --out DIR [--set key=value]... [--quiet] [--model NAME]\n"
-    "Runs the elastic solid of a case alone (keys dp, end_time, gravity.*, output.*, solid.*).";
+    "       solid_solver [--model NAME] --connect ENDPOINT [--timeout S]   (under the coupler)\n"
+    "Runs the elastic solid of a case alone (keys dp, end_time, gravity.*, output.*, solid.*),\n"
+    "or as the coupler's solid: the coupler starts it with --connect (its --solid \"COMMAND\"\n"
+    "or the case key solid_solver names the command, e.g. \"solid_solver --model tlsph\").";
 
 #define MAX_FIELDS 24
 
@@ -76,6 +83,8 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
     mps_host_describe(host, sizeof host);
     mps_json_str(&j, "host", host);   /* the timings below are this machine's */
     mps_json_str(&j, "case", mps_case_path(c));
+    mps_prov_json(c, &j);
+    mps_json_str(&j, "model", r->ops->name);
     mps_json_int(&j, "particles", (long long)n);
     mps_json_int(&j, "steps", steps);
     mps_json_num(&j, "time", t);
@@ -111,21 +120,29 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
                                                  mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
+    if (model_name && !solid_model_find(model_name))
+        return mps_err_set(err, MPS_EINPUT, "--model %s: unknown solid model (known: %s)",
+                           model_name, solid_model_names());
+    /* --model is solid.model (after the user's --set), and this command is
+     * the run's record: the files say what ran */
+    const char *sets[MPS_CLI_MAX_SETS + 1 + MPS_PROV_NSETS];
+    char model_set[64];
+    int nsets = 0;
+    for (int k = 0; k < cli->nsets; k++)
+        sets[nsets++] = cli->sets[k];
+    if (model_name) {
+        snprintf(model_set, sizeof model_set, "solid.model=%s", model_name);
+        sets[nsets++] = model_set;
+    }
+    mps_prov_sets(sets, &nsets, MPS_CLI_MAX_SETS + 1 + MPS_PROV_NSETS);
     struct mps_case *c = NULL;
-    enum mps_status st = mps_case_load(&c, cli->case_path, cli->sets, cli->nsets, tables, 3,
-                                       ignore, err);
+    enum mps_status st = mps_case_load(&c, cli->case_path, sets, nsets, tables, 3, ignore, err);
     if (st != MPS_OK)
         return st;
     struct run r = {0};
     char *yaml = NULL;
-    if (!model_name)
-        model_name = mps_case_string(c, "solid.model");
-    r.ops = solid_model_find(model_name);
-    if (!r.ops) {
-        st = mps_err_set(err, MPS_EINPUT, "--model %s: unknown solid model (known: %s)",
-                         model_name, solid_model_names());
-        goto done;
-    }
+    /* solid.model's choices are the models' names */
+    r.ops = solid_model_find(mps_case_string(c, "solid.model"));
     if (!cli->out_dir) {
         st = mps_err_set(err, MPS_EINPUT, "missing --out DIR (see --help)");
         goto done;
@@ -154,7 +171,9 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
         names[k] = r.ops->probe_name(r.model, k);
     char path[4096];
     snprintf(path, sizeof path, "%s/probes.csv", cli->out_dir);
-    st = mps_probes_open(&r.probes, path, names, r.nprobes, err);
+    char *comment = mps_prov_comment(c, "solid_solver");
+    st = mps_probes_open(&r.probes, path, comment, names, r.nprobes, err);
+    free(comment);
     free(names);
     if (st != MPS_OK)
         goto done;
@@ -254,6 +273,7 @@ static int run_coupled(int argc, char **argv, const char *endpoint, int hello_ms
 
 int main(int argc, char **argv)
 {
+    mps_prov_init(argc, argv);
     struct mps_cli cli;
     struct mps_err err = {0};
     const char *endpoint = NULL;

@@ -12,6 +12,20 @@
 #include "mps_err.h"
 #include "mps_h5.h"
 #include "mps_json.h"
+#include "mps_particles.h"
+
+/* What the coded fields of every model's snapshots mean (HDF5 "legend"). */
+#define SOLID_LEGEND_FIXED "1 clamped (never moves), 0 free"
+#define SOLID_LEGEND_SURFACE "1 on a body's surface (initial or made by fracture), 0 inside"
+#define SOLID_LEGEND_BODY "index of the body in solid.bodies"
+
+/* Sets those legends on a model's particle table (fields fixed, surface, body). */
+static inline void solid_model_legends(struct mps_particles *ps)
+{
+    mps_particles_set_legend(ps, "fixed", SOLID_LEGEND_FIXED);
+    mps_particles_set_legend(ps, "surface", SOLID_LEGEND_SURFACE);
+    mps_particles_set_legend(ps, "body", SOLID_LEGEND_BODY);
+}
 
 /* What a coupled fluid needs of the solid: the surface particles (they take
  * part in the fluid's pressure Poisson equation and receive loads) and the

@@ -38,6 +38,7 @@ static void register_fields(struct solid_mps *s)
     mps_particles_add_field(ps, "id", 1, MPS_I32, (void **)&s->id, "", 1);
     mps_particles_add_field(ps, "body", 1, MPS_I32, (void **)&s->body, "", 1);
     mps_particles_add_field(ps, "surface", 1, MPS_U8, (void **)&s->surface, "", 1);
+    solid_model_legends(ps);
     if (s->scene.eps_max > 0.0) /* fracture only: nothing allocated otherwise */
         mps_particles_add_field(ps, "number_density", 1, MPS_F64, (void **)&s->nden, "", 1);
 }

@@ -6,7 +6,10 @@
 
 #include "mps_case.h"
 #include "mps_cli.h"
+#include "mps_host.h"
 #include "mps_json.h"
+#include "mps_prov.h"
+#include "mps_version.h"
 #include "mps_timer.h"
 #include "proto_solver.h"
 #include "solid_scene.h"
@@ -66,7 +69,13 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
                                                  mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
-    enum mps_status st = mps_case_load(&p->cs, case_path, NULL, 0, tables, 3, ignore, err);
+    /* --model NAME is solid.model, so the snapshots' /config says what runs */
+    char model_set[64];
+    const char *sets[1] = {model_set};
+    if (p->ops)
+        snprintf(model_set, sizeof model_set, "solid.model=%s", p->ops->name);
+    enum mps_status st =
+        mps_case_load(&p->cs, case_path, sets, p->ops ? 1 : 0, tables, 3, ignore, err);
     if (st)
         return st;
     if (!p->ops && !(p->ops = solid_model_find(mps_case_string(p->cs, "solid.model"))))
@@ -143,6 +152,14 @@ static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const str
     mps_json_str(&j, "solver", "solid_solver");
     mps_json_str(&j, "model", p->ops ? p->ops->name : "");
     mps_json_str(&j, "version", MPS_VERSION);
+    mps_json_str(&j, "git_rev", mps_git_rev);
+    char host[256];
+    mps_host_describe(host, sizeof host);
+    mps_json_str(&j, "host", host);
+    if (p->cs) {
+        mps_json_str(&j, "case", mps_case_path(p->cs));
+        mps_prov_json(p->cs, &j);
+    }
     mps_json_str(&j, "status", mps_status_name(st));
     mps_json_str(&j, "message", st ? err->msg : "");
     mps_json_num(&j, "wall_seconds", mps_wall_seconds() - p->wall0);

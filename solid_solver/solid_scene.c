@@ -5,6 +5,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "mps_budget.h"
+
 #define ANY (MPS_KEY_NO_LO | MPS_KEY_NO_HI)
 #define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
 
@@ -82,7 +84,9 @@ const struct mps_key_spec solid_case_keys[] = {
 static long lattice_count(double lo, double hi, double dp)
 {
     double n = floor((hi - lo) / dp + 1e-6);
-    return n > 0 ? (long)n : 0;
+    /* capped so the conversion stays defined; the memory check refuses
+     * such a body anyway */
+    return n > 0 ? (long)fmin(n, 1e15) : 0;
 }
 
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
@@ -181,6 +185,17 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             if (strcmp(s->bodies[a].name, d->name) == 0)
                 return mps_case_fail(c, err, key, "body name already used by "
                                      "solid.bodies.%d", a);
+        /* two bodies in one place would put particles on top of each other */
+        for (int a = 0; a < b; a++) {
+            const struct solid_body_def *o = &s->bodies[a];
+            double tol = 1e-3 * s->dp;
+            if (fmin(d->x1, o->x1) - fmax(d->x0, o->x0) > tol &&
+                fmin(d->y1, o->y1) - fmax(d->y0, o->y0) > tol) {
+                snprintf(key, sizeof key, "solid.bodies.%d.x0", b);
+                return mps_case_fail(c, err, key, "body '%s' overlaps body '%s' ([%g, %g] x "
+                                     "[%g, %g])", d->name, o->name, o->x0, o->x1, o->y0, o->y1);
+            }
+        }
         long nx, ny;
         solid_scene_lattice(s, b, &nx, &ny);
         if (nx == 0) {
@@ -191,6 +206,17 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
                                  wide ? "y0" : "x0");
         }
     }
+
+    double nparticles = 0.0;
+    for (int b = 0; b < s->nbodies; b++) {
+        long nx, ny;
+        solid_scene_lattice(s, b, &nx, &ny);
+        nparticles += (double)nx * (double)ny;
+    }
+    enum mps_status st = mps_budget_check(c, "dp", "solid", nparticles, MPS_BUDGET_SOLID_BYTES,
+                                          err);
+    if (st)
+        return st;
 
     s->nclamps = mps_case_count(c, "solid.clamps");
     if (s->nclamps > SOLID_MAX_CLAMPS)
@@ -296,11 +322,6 @@ double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
     return probe_n[k] ? sum / probe_n[k] : NAN;
 }
 
-double solid_probe_tank_angle(const struct mps_motion *m, double t)
-{
-    return mps_motion_moving(m) ? mps_motion_at(m, t).theta * (180.0 / 3.14159265358979323846)
-                                : 0.0;
-}
 
 enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, size_t n,
                                   const struct solid_loads *f, double (*aload)[MPS_DIM],

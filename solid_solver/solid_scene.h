@@ -96,7 +96,11 @@ double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
                          const double (*x0)[MPS_DIM]);
 
 /* The tank_angle probe: theta at time t in degrees (0 without motion). */
-double solid_probe_tank_angle(const struct mps_motion *m, double t);
+static inline double solid_probe_tank_angle(const struct mps_motion *m, double t)
+{
+    return mps_motion_moving(m) ? mps_motion_at(m, t).theta * (180.0 / 3.14159265358979323846)
+                                : 0.0;
+}
 
 /* Fluid loads (force per particle, N per metre depth) as accelerations:
  * aload[i] = force / (rho_body V), V = dp^2; particles not listed get zero.

@@ -53,6 +53,7 @@ static void register_fields(struct solid_tlsph *s)
     mps_particles_add_field(ps, "body", 1, MPS_I32, (void **)&s->body, "", 1);
     mps_particles_add_field(ps, "neighbours", 1, MPS_I32, (void **)&s->nnb, "", 0);
     mps_particles_add_field(ps, "surface", 1, MPS_U8, (void **)&s->surface, "", 1);
+    solid_model_legends(ps);
 }
 
 /* Lattices as in solid_mps (column by column when wider than tall, so pairs

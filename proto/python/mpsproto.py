@@ -384,12 +384,82 @@ def read_frames(path) -> list:
 
 # ---- ZeroMQ link (PROTOCOL.md sections 1 and 7) ----
 
-def connect(ctx, endpoint: str):
-    """A solver's DEALER socket, connected, with the protocol's linger and send timeout."""
+# ---- CURVE keys (PROTOCOL.md section 10) ----
+
+KEY_ENV = "MPS_COUPLING_KEY"
+KEY_FIELDS = ("server_public", "client_public", "client_secret")
+
+
+def read_key(path) -> dict:
+    """A solver's key file: {'server_public', 'client_public', 'client_secret'}
+    as Z85 bytes. ValueError (naming file and line) for a file others may
+    read, a missing, repeated or unknown name, a value that is not a 40-char
+    Z85 key, or a public key that does not belong to the secret one."""
+    import os
+    import stat
+    import zmq
+    from zmq.utils import z85
+    st = os.stat(path)
+    if not stat.S_ISREG(st.st_mode):
+        raise ValueError(f"{path}: the key file is not a regular file")
+    if st.st_mode & 0o077:
+        raise ValueError(f"{path}: the key file has mode {stat.S_IMODE(st.st_mode):04o}, "
+                         f"others may read it: chmod 600 {path}")
+    keys = {}
+    with open(path, "rb") as f:
+        data = f.read(4097)
+    if len(data) > 4096 or b"\0" in data:
+        raise ValueError(f"{path}: not a key file")
+    for n, line in enumerate(data.decode("ascii", "replace").split("\n"), 1):
+        line = line.rstrip("\r")
+        if not line or line.startswith("#"):
+            continue
+        name, eq, value = line.partition("=")
+        if not eq or name not in KEY_FIELDS:
+            raise ValueError(f"{path}:{n}: expected server_public=, client_public= or "
+                             f"client_secret=, got '{line[:40]}'")
+        if name in keys:
+            raise ValueError(f"{path}:{n}: {name} given twice")
+        if len(value) != 40:
+            raise ValueError(f"{path}:{n}: {name} is {len(value)} characters, a Z85 key has 40")
+        try:
+            z85.decode(value.encode())
+        except (ValueError, KeyError, IndexError) as e:
+            raise ValueError(f"{path}:{n}: {name} is not a Z85 key") from e
+        keys[name] = value.encode()
+    for name in KEY_FIELDS:
+        if name not in keys:
+            raise ValueError(f"{path}: {name} missing")
+    if zmq.curve_public(keys["client_secret"]) != keys["client_public"]:
+        raise ValueError(f"{path}: client_public does not belong to client_secret")
+    return keys
+
+
+def connect(ctx, endpoint: str, key_file=None):
+    """A solver's DEALER socket, connected, with the protocol's linger and send
+    timeout. A tcp endpoint is a CURVE client with the keys of key_file (or of
+    the file named by the environment variable MPS_COUPLING_KEY, which the
+    coupler sets for the solvers it launches); ProtocolError if there is none."""
+    import os
     import zmq
     s = ctx.socket(zmq.DEALER)
     s.setsockopt(zmq.LINGER, LINGER_MS)
     s.setsockopt(zmq.SNDTIMEO, SEND_TIMEOUT_MS)
+    if endpoint.startswith("tcp://"):
+        key_file = key_file or os.environ.get(KEY_ENV)
+        if not key_file:
+            s.close(0)
+            raise ProtocolError(f"{endpoint}: a tcp endpoint needs the run's key: --key FILE "
+                                f"(or {KEY_ENV}=FILE in the environment; PROTOCOL.md section 10)")
+        try:
+            k = read_key(key_file)
+        except (OSError, ValueError):
+            s.close(0)
+            raise
+        s.setsockopt(zmq.HANDSHAKE_IVL, 5000)
+        s.curve_serverkey = k["server_public"]
+        s.curve_publickey = k["client_public"]
+        s.curve_secretkey = k["client_secret"]
     s.connect(endpoint)
     return s
 

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """A third-party solid: an elastic plate as a cantilever beam in its first
 bending mode, written in Python against proto/PROTOCOL.md only (numpy, pyzmq,
-PyYAML from Debian; the wire codec is proto/python/mpsproto.py, itself written
-from PROTOCOL.md). It proves a solver in another language can replace ours.
+PyYAML, h5py from Debian; the wire codec is proto/python/mpsproto.py, itself
+written from PROTOCOL.md). It proves a solver in another language can replace
+ours.
 
 Model (Euler-Bernoulli, per metre depth): the first body of the case is a
 vertical plate of thickness b = x1 - x0 clamped where a solid.clamps region
@@ -12,14 +13,18 @@ mode normalised to phi(L) = 1. Then M q'' + K q = F with M = rho b int phi^2,
 K = E b^3/12 int phi''^2 (= omega_1^2 M) and F = sum_k f_x,k phi(s_k), the
 generalised force of the fluid loads. q is the tip deflection (probe tip_dx).
 
-Snapshots (at startup and after an ADVANCE with SNAPSHOT) are CSV files
-OUT/PREFIX_NNNNNN.csv. Failures are reported to the coupler as ERROR
-(PROTOCOL.md 8). tests/coupler/conformance.py checks it against the protocol.
+Snapshots (at startup and after an ADVANCE with SNAPSHOT) are HDF5 files
+OUT/PREFIX_NNNNNN.h5, NNNNNN counting snapshots, with an XDMF index
+OUT/PREFIX.xmf in the layout the C solvers write (docs/output.md), so the
+coupler's scene.xmf shows the plate with the fluid. Failures are reported to
+the coupler as ERROR (PROTOCOL.md 8). tests/coupler/conformance.py checks it
+against the protocol.
 
-usage: modal_beam_solid.py [--courant C] --connect ENDPOINT
+usage: modal_beam_solid.py [--courant C] [--key FILE] --connect ENDPOINT
 """
 import json, math, os, sys, time
 
+import h5py
 import numpy as np
 import yaml
 import zmq
@@ -93,18 +98,74 @@ class Fail(Exception):
         super().__init__(f'{status}: {message}')
 
 
-def snapshot(conf, step, t, beam):
-    """Writes OUT/PREFIX_NNNNNN.csv (id, x, y, vx, vy, surface, fixed): the
-    protocol asks for a snapshot at startup and after an ADVANCE with SNAPSHOT;
-    the format is the solver's own."""
-    x, v = beam.state()
-    path = os.path.join(conf['out'], f"{conf['prefix']}_{step:06d}.csv")
-    try:
-        np.savetxt(path, np.column_stack([beam.id, x, v, beam.surface, beam.fixed]),
-                   fmt=['%d', '%.17g', '%.17g', '%.17g', '%.17g', '%d', '%d'], delimiter=',',
-                   header=f'time = {t!r} s\nid,x,y,vx,vy,surface,fixed')
-    except OSError as e:
-        raise Fail('io', f'cannot write {path}: {e}') from e
+class Snapshots:
+    """OUT/PREFIX_NNNNNN.h5 and the index OUT/PREFIX.xmf, as common/mps_h5.c
+    writes them (vectors with 3 components, z = 0; the index one element per
+    line, rewritten through a temporary file, so the coupler's scene.xmf can
+    take its grids). The protocol asks for a snapshot at startup and after an
+    ADVANCE with SNAPSHOT; the format is the solver's own."""
+
+    def __init__(self, out, prefix, config_text):
+        self.out, self.prefix, self.config = out, prefix, config_text
+        self.grids = []
+
+    def write(self, step, t, beam):
+        x, v = beam.state()
+        n = len(x)
+        pad = lambda a: np.column_stack([a, np.zeros(n)])  # noqa: E731
+        name = f'{self.prefix}_{len(self.grids):06d}'
+        path = os.path.join(self.out, name + '.h5')
+        fields = [('velocity', pad(v), 'm/s'), ('displacement', pad(x - beam.x0), 'm'),
+                  ('id', beam.id, ''), ('surface', beam.surface, ''), ('fixed', beam.fixed, '')]
+        legends = {'surface': '1 on the plate\'s edge (given to the fluid), 0 inside',
+                   'fixed': '1 clamped (never moves), 0 free'}
+        try:
+            with h5py.File(path + '.tmp', 'w') as h:
+                h.attrs['time'] = float(t)
+                h.attrs['step'] = np.int64(step)
+                h.attrs['solver'] = 'modal_beam_solid'
+                h['config'] = self.config
+                h['topology'] = np.arange(n, dtype=np.int32)  # Polyvertex connectivity
+                g = h.create_group('particles')
+                g['position'] = pad(x)
+                g['position'].attrs['units'] = 'm'
+                for fname, data, units in fields:
+                    g[fname] = data
+                    g[fname].attrs['units'] = units
+                    if fname in legends:
+                        g[fname].attrs['legend'] = legends[fname]
+            os.replace(path + '.tmp', path)
+        except OSError as e:
+            raise Fail('io', f'cannot write {path}: {e}') from e
+        item = lambda what, dims, num: (  # noqa: E731
+            f'     <DataItem Dimensions="{dims}" {num} Format="HDF">{name}.h5:/particles/{what}'
+            '</DataItem>\n')
+        f64, i32, u8 = ('NumberType="Float" Precision="8"', 'NumberType="Int" Precision="4"',
+                        'NumberType="UChar" Precision="1"')
+        grid = (f'   <Grid Name="{name}" GridType="Uniform">\n'
+                f'    <Time Value="{t!r}"/>\n'
+                f'    <Topology TopologyType="Polyvertex" NumberOfElements="{n}" NodesPerElement="1">\n'
+                f'     <DataItem Dimensions="{n}" {i32} Format="HDF">{name}.h5:/topology</DataItem>\n'
+                '    </Topology>\n'
+                '    <Geometry GeometryType="XYZ">\n' + item('position', f'{n} 3', f64) +
+                '    </Geometry>\n')
+        for fname, data, _ in fields:
+            vec = data.ndim == 2
+            num = f64 if data.dtype == np.float64 else i32 if data.dtype == np.int32 else u8
+            grid += (f'    <Attribute Name="{fname}" AttributeType="{"Vector" if vec else "Scalar"}" '
+                     'Center="Node">\n' + item(fname, f'{n} 3' if vec else f'{n}', num) +
+                     '    </Attribute>\n')
+        self.grids.append(grid + '   </Grid>\n')
+        index = os.path.join(self.out, self.prefix + '.xmf')
+        try:
+            with open(index + '.tmp', 'w') as f:
+                f.write('<?xml version="1.0" ?>\n<Xdmf Version="2.0">\n <Domain>\n'
+                        f'  <Grid Name="{self.prefix}" GridType="Collection" CollectionType="Temporal">\n')
+                f.writelines(self.grids)
+                f.write('  </Grid>\n </Domain>\n</Xdmf>\n')
+            os.replace(index + '.tmp', index)
+        except OSError as e:
+            raise Fail('io', f'cannot write {index}: {e}') from e
 
 
 def converse(sock, courant, t_wall):
@@ -127,13 +188,15 @@ def converse(sock, courant, t_wall):
             raise Fail('input', f"CONFIG key '{k}' unknown")
     try:
         with open(conf['case']) as f:
-            case = yaml.safe_load(f)
+            config_text = f.read()
+        case = yaml.safe_load(config_text)
         beam = Beam(case, courant)
     except (OSError, KeyError, TypeError, ValueError, IndexError, yaml.YAMLError) as e:
         raise Fail('input', f"case {conf['case']}: {type(e).__name__}: {e}") from e
     timeout = int(conf.get('timeout_ms', '1800000'))
     step = 0
-    snapshot(conf, 0, 0.0, beam)
+    snaps = Snapshots(conf['out'], conf['prefix'], config_text)
+    snaps.write(0, 0.0, beam)
 
     def state_msg(mtype, **kw):
         x, v = beam.state()
@@ -167,7 +230,7 @@ def converse(sock, courant, t_wall):
         beam.advance(m.dt / m.n_sub, m.n_sub)
         step += 1
         if m.flags & mp.F_SNAPSHOT:
-            snapshot(conf, m.step + 1, m.time + m.dt, beam)
+            snaps.write(m.step + 1, m.time + m.dt, beam)
         kw = {}
         if m.flags & mp.F_PROBES:
             kw = dict(flags=mp.F_PROBES, probes=np.array([beam.q]))
@@ -180,8 +243,14 @@ def main():
     args = sys.argv[1:]
     endpoint = args[args.index('--connect') + 1]
     courant = float(args[args.index('--courant') + 1]) if '--courant' in args else 0.5
+    key = args[args.index('--key') + 1] if '--key' in args else None
     ctx = zmq.Context()
-    sock = mp.connect(ctx, endpoint)
+    try:
+        sock = mp.connect(ctx, endpoint, key)  # tcp: CURVE (PROTOCOL.md section 10)
+    except (mp.ProtocolError, OSError, ValueError) as e:
+        print(f'modal_beam_solid: input: {e}', file=sys.stderr)
+        ctx.term()
+        return 2
     mp.send(sock, mp.Message(mp.Type.HELLO, text=f'role=solid model=modal_beam pid={os.getpid()}'))
     try:
         code = converse(sock, courant, time.time())

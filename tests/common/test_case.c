@@ -231,10 +231,14 @@ static void test_errors(void)
     snprintf(text, sizeof text, "%sfluid:\n  rhoo: 1000\n", base);
     expect_error(text, NULL, 0, "@:4: fluid.rhoo = 1000: unknown key", "did you mean fluid.rho?",
                  NULL);
-    snprintf(text, sizeof text, "%sfluid:\n  blcks:\n    - {x0: 0, x1: 1}\n    - {x0: 0, x1: 1}\n",
-             base);
+    /* the suggestion keeps the item's index (an empty first item, so that
+     * the one-line message starts with item 1) */
+    snprintf(text, sizeof text, "%sfluid:\n  blcks:\n    - {}\n    - {x0: 0}\n", base);
     expect_error(text, NULL, 0, "@:6: fluid.blcks.1.x0 = 0: unknown key",
                  "did you mean fluid.blocks.1.x0?", NULL);
+    /* one line however many problems: the first, the count, the next */
+    expect_error("dp: -1\nend_time: 0\ngravity: {x: a}\n", NULL, 0, "@:1: dp = -1: must be > 0",
+                 "(and 2 more problems; the next: @:2: end_time = 0: must be > 0)", NULL);
     expect_error("dp: 0.01\nend_tmie: 1\n", NULL, 0, "@:2: end_tmie = 1: unknown key",
                  "did you mean end_time?", "@: missing required key 'end_time'");
     expect_error("dp: 0.01\nend_time: 1\nzzz: 1\n", NULL, 0, "@:3: zzz = 1: unknown key", NULL,
@@ -346,7 +350,7 @@ static void test_round_trip(void)
     int fd = mkstemp(out);
     CHECK(fd >= 0);
     close(fd);
-    CHECK(mps_case_write_resolved(c, out, &err) == MPS_OK);
+    CHECK(mps_case_write_resolved(c, out, "# note: kept\n", &err) == MPS_OK);
     struct mps_case *r = load(out, NULL, 0, &err);
     CHECK(r != NULL);
     if (!r) {

@@ -161,10 +161,10 @@ static void write_fluid(const char *dir)
             u[i] = uval(sn, i);
         }
         struct mps_field fields[] = {
-            {"velocity", MPS_DIM, MPS_F64, v, "m/s"},
-            {"pressure", 1, MPS_F64, p, "Pa"},
-            {"id", 1, MPS_I32, id, ""},
-            {"type", 1, MPS_U8, u, NULL},
+            {"velocity", MPS_DIM, MPS_F64, v, "m/s", NULL},
+            {"pressure", 1, MPS_F64, p, "Pa", NULL},
+            {"id", 1, MPS_I32, id, "", NULL},
+            {"type", 1, MPS_U8, u, NULL, "250 this, 249 that"},
         };
         enum mps_status st = mps_h5_write(s, 0.1 * sn, 10L * sn + 1234567890123L, N,
                                           (const double(*)[MPS_DIM])x, fields, 4, &err);
@@ -216,11 +216,12 @@ static void check_fluid(const char *dir)
         H5Tclose(dt);
         H5Dclose(d);
 
-        double x[N][MPS_DIM], v[N][MPS_DIM], p[N];
+        /* vectors have 3 components in the file whatever MPS_DIM is, z = 0 in 2D */
+        double x[N][MPS_H5_VEC], v[N][MPS_H5_VEC], p[N];
         int id[N];
         uint8_t u[N];
-        read_field(f, "position", H5T_NATIVE_DOUBLE, N, MPS_DIM, "m", x);
-        read_field(f, "velocity", H5T_NATIVE_DOUBLE, N, MPS_DIM, "m/s", v);
+        read_field(f, "position", H5T_NATIVE_DOUBLE, N, MPS_H5_VEC, "m", x);
+        read_field(f, "velocity", H5T_NATIVE_DOUBLE, N, MPS_H5_VEC, "m/s", v);
         read_field(f, "pressure", H5T_NATIVE_DOUBLE, N, 1, "Pa", p);
         read_field(f, "id", H5T_NATIVE_INT, N, 1, "", id);
         read_field(f, "type", H5T_NATIVE_UINT8, N, 1, "", u);
@@ -228,9 +229,26 @@ static void check_fluid(const char *dir)
         for (int i = 0; i < N; i++) {
             for (int dd = 0; dd < MPS_DIM; dd++)
                 bad += x[i][dd] != xval(sn, i, dd) || v[i][dd] != vval(sn, i, dd);
+            for (int dd = MPS_DIM; dd < MPS_H5_VEC; dd++)
+                bad += x[i][dd] != 0.0 || v[i][dd] != 0.0;
             bad += p[i] != pval(sn, i) || id[i] != ival(sn, i) || u[i] != uval(sn, i);
         }
         CHECK(bad == 0);
+        /* the Polyvertex connectivity, 0 .. n-1 */
+        int topo[N];
+        d = H5Dopen2(f, "/topology", H5P_DEFAULT);
+        CHECK(d >= 0 && H5Dread(d, H5T_NATIVE_INT, H5S_ALL, H5S_ALL, H5P_DEFAULT, topo) >= 0);
+        H5Dclose(d);
+        for (int i = 0; i < N; i++)
+            bad += topo[i] != i;
+        CHECK(bad == 0);
+        /* a coded field says what its codes mean; the others have no legend */
+        d = H5Dopen2(f, "/particles/type", H5P_DEFAULT);
+        CHECK(str_attr_is(d, "legend", "250 this, 249 that"));
+        H5Dclose(d);
+        d = H5Dopen2(f, "/particles/id", H5P_DEFAULT);
+        CHECK(H5Aexists(d, "legend") == 0);
+        H5Dclose(d);
         /* on-disk types: float64, int32, uint8 */
         d = H5Dopen2(f, "/particles/type", H5P_DEFAULT);
         dt = H5Dget_type(d);
@@ -254,7 +272,12 @@ static void check_fluid(const char *dir)
     CHECK(strstr(t, "CollectionType=\"Temporal\"") != NULL);
     CHECK(count(t, "GridType=\"Uniform\"") == 3);
     CHECK(count(t, "TopologyType=\"Polyvertex\" NumberOfElements=\"7\"") == 3);
-    CHECK(count(t, MPS_DIM == 2 ? "GeometryType=\"XY\"" : "GeometryType=\"XYZ\"") == 3);
+    for (int sn = 0; sn < 3; sn++) {
+        char want[128];
+        snprintf(want, sizeof want, "Precision=\"4\" Format=\"HDF\">fluid_%06d.h5:/topology<", sn);
+        CHECK(count(t, want) == 1);
+    }
+    CHECK(count(t, "GeometryType=\"XYZ\"") == 3);
     for (int sn = 0; sn < 3; sn++) {
         char want[128];
         snprintf(want, sizeof want, ">fluid_%06d.h5:/particles/position<", sn);
@@ -269,10 +292,10 @@ static void check_fluid(const char *dir)
     CHECK(count(t, "<Attribute Name=\"pressure\" AttributeType=\"Scalar\"") == 3);
     char want[128];
     snprintf(want, sizeof want, "Dimensions=\"7 %d\" NumberType=\"Float\" Precision=\"8\"",
-             MPS_DIM);
+             MPS_H5_VEC);
     CHECK(count(t, want) == 6); /* position and velocity, 3 snapshots */
     CHECK(count(t, "Dimensions=\"7\" NumberType=\"Float\" Precision=\"8\"") == 3);
-    CHECK(count(t, "Dimensions=\"7\" NumberType=\"Int\" Precision=\"4\"") == 3);
+    CHECK(count(t, "Dimensions=\"7\" NumberType=\"Int\" Precision=\"4\"") == 6); /* id, topology */
     CHECK(count(t, "Dimensions=\"7\" NumberType=\"UChar\" Precision=\"1\"") == 3);
     free(t);
     check_xml(path);
@@ -292,7 +315,7 @@ static void write_solid(const char *dir)
     double pr[2] = {1, 2};
     for (int sn = 0; sn < 6; sn++) {
         size_t n = sn == 0 ? 0 : 2;
-        struct mps_field fields[] = {{"stress", 1, MPS_F64, n ? pr : NULL, "Pa"}};
+        struct mps_field fields[] = {{"stress", 1, MPS_F64, n ? pr : NULL, "Pa", NULL}};
         enum mps_status st = mps_h5_write(s, 0.045 * sn, sn, n,
                                           n ? (const double(*)[MPS_DIM])x : NULL, fields, 1, &err);
         CHECK(st == MPS_OK);
@@ -306,7 +329,7 @@ static void write_solid(const char *dir)
     hid_t f = H5Fopen(path, H5F_ACC_RDONLY, H5P_DEFAULT);
     CHECK(f >= 0);
     double dummy;
-    read_field(f, "position", H5T_NATIVE_DOUBLE, 0, MPS_DIM, "m", &dummy);
+    read_field(f, "position", H5T_NATIVE_DOUBLE, 0, MPS_H5_VEC, "m", &dummy);
     read_field(f, "stress", H5T_NATIVE_DOUBLE, 0, 1, "Pa", &dummy);
     CHECK(str_attr_is(f, "solver", "solid_solver"));
     H5Fclose(f);
@@ -351,7 +374,7 @@ static void check_scene(const char *dir)
         CHECK(strstr(chunk, want) != NULL);
         snprintf(want, sizeof want, ">solid_%06d.h5:/particles/stress<", want_solid[k]);
         CHECK(strstr(chunk, want) != NULL);
-        CHECK(count(chunk, "solid_0") == 3); /* name, position, stress of one snapshot */
+        CHECK(count(chunk, "solid_0") == 4); /* name, topology, position, stress of one snapshot */
         free(chunk);
         p = c + 1;
     }
@@ -400,7 +423,7 @@ static void check_errors(const char *dir)
     CHECK(access(tmp, F_OK) != 0);
 
     /* a field without data, a non-finite time */
-    struct mps_field f = {"p", 1, MPS_F64, NULL, "Pa"};
+    struct mps_field f = {"p", 1, MPS_F64, NULL, "Pa", NULL};
     CHECK(mps_h5_write(s, 0.0, 0, 1, (const double(*)[MPS_DIM])x, &f, 1, &err) == MPS_EINPUT);
     CHECK(mps_h5_write(s, 0.0 / 0.0, 0, 1, (const double(*)[MPS_DIM])x, NULL, 0, &err) ==
           MPS_EINPUT);

@@ -301,10 +301,22 @@ static void test_errors(void)
     expect_error("dp: 0.01\nend_time: 10\nmotion: {kind: table, pivot: {x: 0, y: 0}, "
                  "table: {file: roll.csv}}\n",
                  "ends at t = 5 s, before end_time = 10 s", NULL);
-    write_file("gap.csv", "0.0, 0\n0.01, 0\n0.02, 0\n0.03, 0\n1.0, 1\n1.01, 1\n");
+    /* rows only in [0, 0.19] and [1, 1.19]: the knots between have none */
+    char gap[2048];
+    size_t gl = 0;
+    for (int k = 0; k < 40; k++)
+        gl += (size_t)snprintf(gap + gl, sizeof gap - gl, "%g, %g\n", (k < 20 ? 0.0 : 1.0) +
+                               0.01 * (k % 20), (double)(k / 20));
+    write_file("gap.csv", gap);
     expect_error("dp: 0.01\nend_time: 1\nmotion: {kind: table, pivot: {x: 0, y: 0}, "
-                 "table: {file: gap.csv, knot_spacing: 0.01}}\n",
+                 "table: {file: gap.csv}}\n",
                  "too few rows between", "knot_spacing");
+    expect_error("dp: 0.01\nend_time: 1\nmotion: {kind: table, pivot: {x: 0, y: 0}, "
+                 "table: {file: gap.csv, knot_spacing: 0.001}}\n",
+                 "knot spans over 1.19 s for 40 rows", NULL);
+    expect_error("dp: 0.01\nend_time: 1\nmotion: {kind: table, pivot: {x: 0, y: 0}, "
+                 "table: {file: /dev/null}}\n",
+                 "/dev/null: not a regular file", NULL);
 }
 
 int main(void)

@@ -43,13 +43,13 @@ static void test_probes(void)
     struct mps_err err = {0};
     struct mps_probes *p = NULL;
     const char *names[] = {"p_gauge1", "h,left", "say \"hi\""};
-    CHECK(mps_probes_open(&p, path, names, 3, &err) == MPS_OK);
+    CHECK(mps_probes_open(&p, path, "# case: a.yml\n", names, 3, &err) == MPS_OK);
     double v1[] = {1.0 / 3.0, -2.5e-20, 101325.0};
     double v2[] = {0.0, 1e300, 12345678901.0};
     CHECK(mps_probes_write(p, 0.0, v1, &err) == MPS_OK);
     /* flushed per row: complete before close */
     char *t = slurp(path);
-    CHECK_STR(t, "time,p_gauge1,\"h,left\",\"say \"\"hi\"\"\"\n"
+    CHECK_STR(t, "# case: a.yml\ntime,p_gauge1,\"h,left\",\"say \"\"hi\"\"\"\n"
                  "0,0.333333333,-2.5e-20,101325\n");
     free(t);
     CHECK(mps_probes_write(p, 0.125, v2, &err) == MPS_OK);
@@ -57,13 +57,13 @@ static void test_probes(void)
     CHECK(p == NULL);
     mps_probes_close(&p);
     t = slurp(path);
-    CHECK_STR(t, "time,p_gauge1,\"h,left\",\"say \"\"hi\"\"\"\n"
+    CHECK_STR(t, "# case: a.yml\ntime,p_gauge1,\"h,left\",\"say \"\"hi\"\"\"\n"
                  "0,0.333333333,-2.5e-20,101325\n"
                  "0.125,0,1e+300,1.23456789e+10\n");
     free(t);
 
     snprintf(path, sizeof path, "%s/no/such/dir/probes.csv", dir);
-    CHECK(mps_probes_open(&p, path, names, 3, &err) == MPS_EIO);
+    CHECK(mps_probes_open(&p, path, NULL, names, 3, &err) == MPS_EIO);
     CHECK(strstr(err.msg, path) != NULL);
     CHECK(p == NULL);
 }

@@ -24,6 +24,10 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
                   gravity on: the solid refuses (ERROR "input: ...", exit 2) or applies the
                   tilted gravity (its free plate falls towards -x, section 4)
   timeout         CONFIG timeout_ms=1000, then silence: ERROR "timeout: ...", exit 1
+  curve           on tcp with CURVE (section 10): the key file reaches the solver
+                  as the coupler passes it (MPS_COUPLING_KEY); HELLO, READY, one
+                  ADVANCE, STOP/BYE, exit 0, authenticated with the issued key
+  curve_no_key    a tcp endpoint and no key: no message, exit non-zero
 
 The case given with --case is copied with gravity set to zero (the common keys
 gravity.x/y) and any --set overrides applied; its path goes to the solver in
@@ -40,7 +44,8 @@ Exit status 0 only if every check passes. On failure one line goes to stderr
 usage: conformance.py --solid "COMMAND [ARG]..." [--case CASE.yml]
                       [--set key=value]... [--build DIR] [--xfail CHECK]...
 --build DIR: a bare program name (no '/') is looked up in DIR/bin first, as the
-coupler looks beside itself. --xfail CHECK (fnmatch pattern): a known failure,
+coupler looks beside itself (default: build/ of this repository, where
+./setup.sh builds), then on PATH. --xfail CHECK (fnmatch pattern): a known failure,
 printed XFAIL; if it passes it is reported XPASS and counts as a failure, so
 the mark is removed once the solver is fixed.
 """
@@ -61,6 +66,7 @@ import time
 import numpy as np
 import yaml
 import zmq
+from zmq.utils import z85
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -187,19 +193,74 @@ def state_problems(m):
 
 # ---------------------------------------------------------------- one solver process
 
+class ZapHandler:
+    """The coupler's ZAP handler in miniature (section 10): admits on domain
+    'solid' the one client key it is given, records every key offered."""
+
+    def __init__(self, ctx):
+        import threading
+        self.sock = ctx.socket(zmq.REP)
+        self.sock.setsockopt(zmq.LINGER, 0)
+        self.sock.bind('inproc://zeromq.zap.01')
+        self.allowed, self.seen, self.stop = None, [], False
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+
+    def _run(self):
+        while not self.stop:
+            if not self.sock.poll(100):
+                continue
+            req = self.sock.recv_multipart()
+            ok = (len(req) >= 7 and req[0] == b'1.0' and req[2] == b'solid' and
+                  req[5] == b'CURVE' and self.allowed is not None and
+                  req[6] == z85.decode(self.allowed))
+            self.seen.append((req[5] if len(req) > 5 else b'?', ok))
+            self.sock.send_multipart([b'1.0', req[1] if len(req) > 1 else b'',
+                                      b'200' if ok else b'400', b'OK' if ok else b'no',
+                                      b'solid' if ok else b'', b''])
+
+    def close(self):
+        self.stop = True
+        self.thread.join()
+        self.sock.close(0)
+
+
 class Session:
     """One solver process on its own endpoint, with the coupler's socket."""
 
-    def __init__(self, suite, name):
+    def __init__(self, suite, name, curve=False, key=True):
         self.suite, self.name = suite, name
         self.dir = os.path.join(suite.tmp, name)
         self.out = os.path.join(self.dir, 'out')
         os.makedirs(self.out)
-        self.endpoint = f'ipc://{self.dir}/solid.sock'
+        self.env = {k: v for k, v in os.environ.items() if k != mp.KEY_ENV}
         self.sock = suite.ctx.socket(zmq.DEALER)
         self.sock.setsockopt(zmq.LINGER, 1000)
         self.sock.setsockopt(zmq.SNDTIMEO, 10000)
-        self.sock.bind(self.endpoint)   # before the launch (section 6, step 1)
+        if curve:
+            # as the coupler does (section 10): keys made for this session,
+            # the solver's key file 0600 in a private directory, its path in
+            # the environment, the ZAP handler admitting that key only
+            os.chmod(self.dir, 0o700)
+            spub, ssec = zmq.curve_keypair()
+            cpub, csec = zmq.curve_keypair()
+            self.client_public = cpub
+            suite.zap.allowed = cpub
+            kf = os.path.join(self.dir, 'solid.key')
+            fd = os.open(kf, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            with os.fdopen(fd, 'w') as f:
+                f.write(f'server_public={spub.decode()}\nclient_public={cpub.decode()}\n'
+                        f'client_secret={csec.decode()}\n')
+            if key:
+                self.env[mp.KEY_ENV] = kf
+            self.sock.curve_server = True
+            self.sock.curve_secretkey = ssec
+            self.sock.zap_domain = b'solid'
+            port = self.sock.bind_to_random_port('tcp://127.0.0.1')
+            self.endpoint = f'tcp://127.0.0.1:{port}'
+        else:
+            self.endpoint = f'ipc://{self.dir}/solid.sock'
+            self.sock.bind(self.endpoint)   # before the launch (section 6, step 1)
         self.log_path = os.path.join(self.dir, 'solver.log')
         self.log = open(self.log_path, 'wb')
         self.proc = None
@@ -208,11 +269,15 @@ class Session:
     def start(self):
         try:
             self.proc = subprocess.Popen(self.suite.command + ['--connect', self.endpoint],
+                                         env=self.env,
                                          stdin=subprocess.DEVNULL, stdout=self.log,
                                          stderr=subprocess.STDOUT, start_new_session=True,
                                          preexec_fn=_die_with_parent)
         except OSError as e:
-            self.suite.check(f'{self.name}.launch', False, f'cannot start {self.suite.command[0]}: {e}')
+            where = '' if '/' in self.suite.command[0] else \
+                f' (not in {os.path.join(self.suite.args.build, "bin")} nor on PATH; see --build)'
+            self.suite.check(f'{self.name}.launch', False,
+                             f'cannot start {self.suite.command[0]}: {e}{where}')
             raise Stop from e
         self.suite.current = self
         self.t0 = time.monotonic()
@@ -297,6 +362,7 @@ class Suite:
         self.args = args
         self.report = Report(args.xfail)
         self.ctx = zmq.Context()
+        self.zap = None   # section 10: started before the first CURVE socket binds
         self.tmp = tempfile.mkdtemp(prefix='conf_')   # short: ipc paths <= 107 bytes
         self.current = None
         self.command = resolve_command(args.solid, args.build)
@@ -761,13 +827,46 @@ class Suite:
             raise Stop
         self.expect_error(s, 'timeout', 'timeout', 1)
 
+    def scenario_curve(self, s):
+        """Section 10: a whole short conversation over tcp with CURVE."""
+        self.hello(s)
+        r = self.ready(s)
+        self.advance(s, 0, 0.0, r.dt, 1, mp.Payload.NONE)
+        s.send(mp.Message(mp.Type.STOP, step=1, time=r.dt))
+        frames, _ = s.recv(EXIT_DEADLINE)
+        ok = frames is not None and len(frames[0]) == 80 and fields(frames)['type'] == 8
+        rc = s.wait_exit(EXIT_DEADLINE)
+        self.check('curve.run', ok and rc == 0,
+                   f'HELLO, READY, RESULT, BYE over CURVE, exit {rc}' if ok else
+                   f'no BYE after STOP (exit {rc})')
+        seen = self.zap.seen
+        self.check('curve.authenticated', seen and all(k == b'CURVE' and a for k, a in seen),
+                   f'{len(seen)} handshake(s), each CURVE with the key issued'
+                   if seen and all(a for _, a in seen) else f'ZAP saw {seen}')
+
+    def scenario_curve_no_key(self, s):
+        """Section 10: no key, no connection: the solver must give up, not
+        fall back to an unauthenticated link."""
+        s.start()
+        frames, _ = s.recv(EXIT_DEADLINE)
+        rc = s.wait_exit(EXIT_DEADLINE)
+        self.check('curve.no_key', frames is None and rc not in (None, 0),
+                   (f'exit status {rc}' if rc is not None else
+                    f'still running {EXIT_DEADLINE:g} s later') +
+                   ('' if frames is None else '; a message got through'))
+
     SCENARIOS = ('run', 'abort', 'reject', 'bad_magic', 'truncated', 'wrong_version',
-                 'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'motion', 'timeout')
+                 'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'motion', 'timeout',
+                 'curve', 'curve_no_key')
 
     def run(self):
         print(f'conformance: solid {" ".join(self.command)}, case {self.args.case}', flush=True)
         for name in self.SCENARIOS:
-            s = Session(self, name)
+            if name.startswith('curve') and self.zap is None:
+                self.zap = ZapHandler(self.ctx)
+            if name.startswith('curve'):
+                self.zap.seen = []
+            s = Session(self, name, curve=name.startswith('curve'), key=name == 'curve')
             n0 = len(self.report.failed())
             try:
                 getattr(self, 'scenario_' + name)(s)
@@ -784,6 +883,8 @@ class Suite:
             if name == 'run' and set(self.report.failed()) & {'run.launch', 'hello.arrives'}:
                 print('      the solver cannot be reached: the other scenarios are skipped')
                 break
+        if self.zap is not None:
+            self.zap.close()
         self.ctx.term()
 
 
@@ -831,7 +932,9 @@ def main():
     ap.add_argument('--solid', required=True, help='solid solver command (quoted)')
     ap.add_argument('--case', default=os.path.join(HERE, 'conformance_case.yml'))
     ap.add_argument('--set', action='append', default=[], metavar='KEY=VALUE')
-    ap.add_argument('--build', help='build directory: bare program names are looked up in BUILD/bin')
+    ap.add_argument('--build', default=os.path.join(HERE, '..', '..', 'build'),
+                    help='build directory: bare program names are looked up in BUILD/bin '
+                         '(default: build/ of this repository)')
     ap.add_argument('--xfail', action='append', default=[], metavar='CHECK',
                     help='a check known to fail (fnmatch pattern)')
     ap.add_argument('--dt', type=float, default=1e-3, help='coupling step, s (default 1e-3)')

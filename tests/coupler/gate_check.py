@@ -10,7 +10,8 @@ length; tip_dy >= -2 mm (the end cannot go down into the floor) and > 0 at
 the largest opening (it swings up on its arc)."""
 import csv, os, sys
 
-rows = list(csv.DictReader(open(os.path.join(sys.argv[1], 'probes.csv'))))
+with open(os.path.join(sys.argv[1], 'probes.csv')) as f:
+    rows = list(csv.DictReader(l for l in f if not l.startswith('#')))  # '#': provenance
 t = [float(r['time']) for r in rows]
 dx = [float(r['tip_dx']) for r in rows]
 dy = [float(r['tip_dy']) for r in rows]

@@ -5,7 +5,8 @@ step, reported its probe, and its plate bent downstream under the water
 import csv, json, os, sys
 
 run = sys.argv[1]
-rows = list(csv.DictReader(open(os.path.join(run, 'probes.csv'))))
+with open(os.path.join(run, 'probes.csv')) as f:
+    rows = list(csv.DictReader(l for l in f if not l.startswith('#')))  # '#': provenance
 tip = [float(r['tip_dx']) for r in rows]
 s = json.load(open(os.path.join(run, 'summary.json')))
 ok = s['status'] == 'ok' and max(tip) > 0.005 and all(t > -1e-3 for t in tip)

@@ -42,3 +42,15 @@ fluid_expect_fail(coupler_bad_simd_env "coupler: environment: MPS_SIMD=sse4: unk
 fluid_expect_fail(fluid_bad_simd_env "fluid_solver: environment: MPS_SIMD=sse4: unknown value"
                   ${CMAKE_COMMAND} -E env MPS_SIMD=sse4 ${FS} ${DB} ${OUT}
                   --set dp=0.01 --set end_time=0.001)
+# No silent choices (issue 23): --out is required (no ./out to mix runs in),
+# and an option naming a solver the case does not need is refused.
+fluid_expect_fail(coupler_bad_no_out "^coupler: missing --out DIR"
+                  ${CMAKE_BINARY_DIR}/bin/coupler ${DB})
+fluid_expect_fail(fluid_bad_no_out "^fluid_solver: missing --out DIR"
+                  ${FS} ${DB})
+fluid_expect_fail(coupler_bad_solid_without_solid "coupler: --solid solid_solver: cases/dambreak/case.yml has no solid \\(solid.bodies\\)"
+                  ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --solid solid_solver)
+fluid_expect_fail(coupler_bad_fluid_without_fluid "coupler: --fluid fluid_solver: cases/cantilever_beam/case.yml has no fluid"
+                  ${CMAKE_BINARY_DIR}/bin/coupler cases/cantilever_beam/case.yml ${OUT} --fluid fluid_solver)
+fluid_expect_fail(coupler_bad_external_unneeded "coupler: --external solid: cases/dambreak/case.yml has no solid"
+                  ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --external solid)

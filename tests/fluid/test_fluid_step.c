@@ -21,6 +21,18 @@
 #include "mps_kernel.h"
 #include "mps_simd.h"
 
+/* prm keeps pointers into the case (strings): each case must outlive its
+ * fluid, so the cases are kept here and freed at exit (the sanitizer build
+ * reports leaks) */
+static struct mps_case *kept_cases[64];
+static int nkept;
+
+static void free_cases(void)
+{
+    for (int k = 0; k < nkept; k++)
+        mps_case_destroy(&kept_cases[k]);
+}
+
 static struct fluid *make(const char *path, const char **sets, int nsets)
 {
     struct mps_err err = {0};
@@ -31,12 +43,14 @@ static struct fluid *make(const char *path, const char **sets, int nsets)
         fprintf(stderr, "%s\n", err.msg);
         return NULL;
     }
+    if (nkept == 0)
+        atexit(free_cases);
+    if (nkept < (int)(sizeof kept_cases / sizeof *kept_cases))
+        kept_cases[nkept++] = cs;
     struct fluid_params prm;
     struct fluid *f = NULL;
     if (fluid_params_read(&prm, cs, &err) || fluid_create(&f, &prm, &err))
         fprintf(stderr, "%s\n", err.msg);
-    /* prm keeps pointers into the case (strings): the case must outlive f;
-     * tests are short, leak it on purpose */
     return f;
 }
 

@@ -34,8 +34,13 @@ add_test(NAME fluid_stable_dambreak
 add_test(NAME fluid_ppe_scaling
   COMMAND /usr/bin/python3 ${FV_DIR}/check_ppe_scaling.py ${FV_SOLVER} ${FV_OUT}/ppe_scaling
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The pressure of the 8 mm dam break must not flicker, whatever the output
+# times, and the output times must not change the run (docs/pressure.md).
+add_test(NAME fluid_pressure_flicker
+  COMMAND sh ${FV_DIR}/scripts/flicker.sh ${FV_SOLVER} ${FV_OUT}/flicker
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(fluid_valid_hydrostatic fluid_valid_dambreak fluid_stable_dambreak
-  fluid_ppe_scaling
+  fluid_ppe_scaling fluid_pressure_flicker
   PROPERTIES LABELS validation TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=1")
 
 # Standalone runs bind their OpenMP threads to CPUs unless the user (or the

@@ -34,3 +34,9 @@ add_test(NAME proto_python_codec
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(proto_python_codec PROPERTIES TIMEOUT 60 LABELS unit
   SKIP_RETURN_CODE 77 ENVIRONMENT "PYTHONPATH=${CMAKE_SOURCE_DIR}/proto/python")
+
+# CURVE key files and a CURVE link (PROTOCOL.md section 10).
+mps_add_test(proto_key
+  SOURCES ${PROTO_TEST_DIR}/test_proto_key.c
+  LIBS mpsproto LABELS unit TIMEOUT 30)
+target_include_directories(proto_key PRIVATE ${CMAKE_SOURCE_DIR}/tests)

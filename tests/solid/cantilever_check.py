@@ -28,7 +28,8 @@ def crossings(t, y, direction):
 
 
 def analyse(path):
-    data = np.genfromtxt(path, delimiter=",", names=True)
+    with open(path) as f:  # '#' lines: the run's provenance
+        data = np.genfromtxt((l for l in f if not l.startswith("#")), delimiter=",", names=True)
     t, dy = data["time"], data["tip_dy"]
     if not np.all(np.isfinite(dy)):
         raise SystemExit(f"{path}: non-finite tip_dy")

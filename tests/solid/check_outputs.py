@@ -21,7 +21,8 @@ def main():
     for f in want:
         if not os.path.isfile(os.path.join(out, f)):
             fails.append(f"missing {f} (have {sorted(os.listdir(out))})")
-    d = np.genfromtxt(os.path.join(out, "probes.csv"), delimiter=",", names=True)
+    with open(os.path.join(out, "probes.csv")) as f:  # '#' lines: the run's provenance
+        d = np.genfromtxt((l for l in f if not l.startswith("#")), delimiter=",", names=True)
     if list(d.dtype.names) != ["time", "tip_dy", "tip_x"]:
         fails.append(f"probes.csv columns {d.dtype.names}")
     if len(d) != 11 or np.max(np.abs(d["time"] - 0.001 * np.arange(11))) > 1e-12:
