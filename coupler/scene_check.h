@@ -1,6 +1,6 @@
 /* Checks across the fluid's and the solid's parts of one case, which no
- * solver sees whole: every solid body inside the tank, no body in a water
- * block. Run by the coupler before it launches anything. */
+ * solver sees whole: every solid body inside the tank (but for clamped parts,
+ * which may stand in the walls' place), no body in a water block. Run by the coupler before it launches anything. */
 #ifndef SCENE_CHECK_H
 #define SCENE_CHECK_H
 
