@@ -21,6 +21,12 @@ import numpy as np
 import yaml
 
 
+
+def csv_rows(path):
+    """The lines of a CSV but its '#' provenance header (probes.csv)."""
+    with open(path) as f:
+        return [line for line in f if not line.startswith('#')]
+
 def snapshots(run, prefix):
     out = {}
     for p in glob.glob(os.path.join(run, f'{prefix}_*.h5')):
@@ -35,7 +41,7 @@ def nearest(snaps, t):
 
 
 def angle_at(run, t):
-    d = np.genfromtxt(os.path.join(run, 'probes.csv'), delimiter=',', names=True)
+    d = np.genfromtxt(csv_rows(os.path.join(run, 'probes.csv')), delimiter=',', names=True)
     return float(np.interp(t, d['time'], d['tank_angle']))
 
 
@@ -72,7 +78,7 @@ def main():
         tf, pf = nearest(fl, t)
         theta = math.radians(angle_at(a.run, tf))
         with h5py.File(pf, 'r') as f:
-            x = f['particles/position'][:]
+            x = f['particles/position'][:, :2]  # (x, y, 0) in the files
             typ = f['particles/type'][:]
             p = f['particles/pressure'][:]
         fluid = typ == 0
@@ -88,7 +94,7 @@ def main():
         if so:
             ts, ps = nearest(so, t)
             with h5py.File(ps, 'r') as f:
-                xs = to_lab(f['particles/position'][:], theta, pivot)
+                xs = to_lab(f['particles/position'][:, :2], theta, pivot)
             ax.scatter(xs[:, 0], xs[:, 1], s=s, c='tab:orange', lw=0, rasterized=True)
         ax.set_aspect('equal')
         ax.set_xlim(-0.02, W + 0.02)

@@ -30,6 +30,12 @@ E, NU, RHO, T, A = 6.0e6, 0.49, 1100.0, 0.004, 0.981
 CASES = {'low': 0.0574, 'high': 0.1148}
 
 
+
+def csv_rows(path):
+    """The lines of a CSV but its '#' provenance header (probes.csv)."""
+    with open(path) as f:
+        return [line for line in f if not line.startswith('#')]
+
 def theory(L, plane):
     Ep = E if plane == 'stress' else E / (1.0 - NU * NU)
     I = T ** 3 / 12.0
@@ -44,7 +50,7 @@ def free_length(H, dp):
 
 
 def measure(path):
-    d = np.genfromtxt(path, delimiter=',', names=True)
+    d = np.genfromtxt(csv_rows(path), delimiter=',', names=True)
     t, x = d['time'], d['tip_dx']
     m = x.mean()
     s = x - m

@@ -53,6 +53,12 @@ COARSE = ['fluid.tank.width=0.610', 'fluid.blocks.1.x1=0.610', 'motion.pivot.x=0
 TLSPH = 'solid_solver --model tlsph'
 
 
+
+def csv_rows(path):
+    """The lines of a CSV but its '#' provenance header (probes.csv)."""
+    with open(path) as f:
+        return [line for line in f if not line.startswith('#')]
+
 def run_list():
     """name -> (case, sets, solid command or None)."""
     r = {}
@@ -122,7 +128,7 @@ def analyse(name, spec, out):
         summ = json.load(open(os.path.join(d, 'summary.json')))
         fl = json.load(open(os.path.join(d, 'fluid_summary.json')))
         so = json.load(open(os.path.join(d, 'solid_summary.json')))
-        p = np.genfromtxt(os.path.join(d, 'probes.csv'), delimiter=',', names=True)
+        p = np.genfromtxt(csv_rows(os.path.join(d, 'probes.csv')), delimiter=',', names=True)
     except (OSError, ValueError) as e:
         res['missing'] = str(e)
         return res
@@ -213,7 +219,7 @@ def plot_tip(rows, out, case, path, names=None):
     for r in rows:
         if r['case'] != case or 'missing' in r or (names and r['name'] not in names):
             continue
-        p = np.genfromtxt(os.path.join(out, r['name'], 'probes.csv'), delimiter=',', names=True)
+        p = np.genfromtxt(csv_rows(os.path.join(out, r['name'], 'probes.csv')), delimiter=',', names=True)
         ax.plot(p['time'], p['tip_dx'] * 100, lw=0.9, label=r['name'])
     lo, hi = ex['window']
     if 'crest' in ex:

@@ -30,6 +30,12 @@ import numpy as np
 import yaml
 
 
+
+def csv_rows(path):
+    """The lines of a CSV but its '#' provenance header (probes.csv)."""
+    with open(path) as f:
+        return [line for line in f if not line.startswith('#')]
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('run')
@@ -43,7 +49,7 @@ def main():
     case = yaml.safe_load(open(os.path.join(a.run, 'case_resolved.yml')))
     if summ.get('status') != 'ok' or summ.get('simulated_time', 0) < a.t_end - 1e-9:
         bad.append(f"run did not finish: {summ.get('status')}: {summ.get('message')}")
-    d = np.genfromtxt(os.path.join(a.run, 'probes.csv'), delimiter=',', names=True)
+    d = np.genfromtxt(csv_rows(os.path.join(a.run, 'probes.csv')), delimiter=',', names=True)
     print(f"fluid: lost {fl.get('lost_particles')}, tank guard uses {fl.get('wall_guard_uses')}, "
           f"escaped at most {d['escaped'].max():.0f}")
     if fl.get('lost_particles') or fl.get('wall_guard_uses') or d['escaped'].max() > 0:

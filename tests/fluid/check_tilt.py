@@ -30,6 +30,12 @@ import h5py
 import numpy as np
 
 
+
+def csv_rows(path):
+    """The lines of a CSV but its '#' provenance header (probes.csv)."""
+    with open(path) as f:
+        return [line for line in f if not line.startswith('#')]
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('run')
@@ -52,7 +58,7 @@ def main():
         sys.exit(1)
     with h5py.File(snaps[-1], 'r') as f:
         t = float(f.attrs['time'])
-        x = f['particles/position'][:]
+        x = f['particles/position'][:, :2]  # (x, y, 0) in the files
         p = f['particles/pressure'][:]
         typ = f['particles/type'][:]
         surf = f['particles/free_surface'][:]
@@ -80,7 +86,7 @@ def main():
     if not abs(slope) < lim:
         bad.append('the surface is not level in the lab frame')
     # probes in the tank frame
-    d = np.genfromtxt(os.path.join(a.run, 'probes.csv'), delimiter=',', names=True)
+    d = np.genfromtxt(csv_rows(os.path.join(a.run, 'probes.csv')), delimiter=',', names=True)
     dl = d['level_left'][-1] - d['level_right'][-1]
     want = (a.width - dp) * math.tan(th)
     print(f'level_left - level_right (tank frame) {dl * 1e3:.2f} mm, expected (W - dp) tan = '
