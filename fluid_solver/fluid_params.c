@@ -23,11 +23,11 @@ const struct mps_key_spec fluid_case_keys[] = {
      "smallest step the CFL condition may ask for before the run is declared diverged"},
     {"fluid.kappa", MPS_KEY_DOUBLE, "0.01", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "relaxation of the PPE source term (Eq. 23)"},
-    {"fluid.kappa_rate", MPS_KEY_ENUM, "fixed", 0, 0, 0, "fixed|per_step", "",
-     "how Eq. 23's kappa scales with the step: per_step is Eq. 23 as printed, a fraction kappa "
-     "of the density error corrected every step (its source and pressure scale as 1/dt^2 when "
-     "the step changes); fixed corrects kappa dt / dt_max per step, a fixed rate kappa / "
-     "fluid.dt_max (the two agree at dt = dt_max; docs/pressure.md)"},
+    {"fluid.kappa_dt", MPS_KEY_DOUBLE, "5e-4", 0, 0, NOHI, NULL, "s",
+     "Eq. 23's kappa per step of at least this length: a step dt shorter than kappa_dt "
+     "corrects kappa dt / kappa_dt of the density error, a fixed rate kappa / kappa_dt, so "
+     "the source and its pressure do not jump when the step changes (as kappa rho / dt^2 "
+     "does: docs/pressure.md); a longer step corrects kappa, as printed; 0: always as printed"},
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
@@ -138,7 +138,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->dt_max = mps_case_double(c, "fluid.dt_max");
     p->dt_min = mps_case_double(c, "fluid.dt_min");
     p->kappa = mps_case_double(c, "fluid.kappa");
-    p->kappa_fixed_rate = strcmp(mps_case_string(c, "fluid.kappa_rate"), "fixed") == 0;
+    p->kappa_dt = mps_case_double(c, "fluid.kappa_dt");
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
     p->initial_hydrostatic =

@@ -43,7 +43,7 @@ struct fluid_params {
     int mixed_source;             /* add the velocity-divergence source term */
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
-    int kappa_fixed_rate;         /* kappa per dt_max (rate kappa/dt_max), not per step */
+    double kappa_dt;              /* s: steps shorter than this correct kappa dt / kappa_dt */
     double re_n, re_lap;          /* effective radii, multiples of dp */
     double beta1, beta2;          /* free-surface double check */
     double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */

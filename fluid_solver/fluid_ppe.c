@@ -238,11 +238,11 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
      * error per step: its pressure scales as 1/dt^2, so a step halved (an
      * output time, an impact) quadrupled it, and the persistent deficit
      * under the surface turned most of the water to P = 0 for a step
-     * (docs/pressure.md). With fluid.kappa_rate = fixed the correction has
-     * the rate kappa / dt_max whatever the step: a fraction kappa dt / dt_max
-     * per step, never more than the paper's kappa (at twice that, still
-     * water at dt = 1 ms drifted to 0.05 m/s in 2 s). */
-    const double dtk = p->kappa_fixed_rate ? p->dt_max : dt;
+     * (docs/pressure.md). Steps shorter than fluid.kappa_dt correct
+     * kappa dt / kappa_dt instead, a fixed rate whatever the step; longer
+     * ones correct kappa, never more (at 2 kappa per step still water at
+     * dt = 1 ms drifted to 0.05 m/s in 2 s). */
+    const double dtk = dt > p->kappa_dt ? dt : p->kappa_dt;
     const double src = p->kappa * p->rho / (dt * dtk) / f->n0;
     const int mixed = p->mixed_source;
     const double div_coef = p->rho / dt;

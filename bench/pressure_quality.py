@@ -1,0 +1,354 @@
+#!/usr/bin/python3
+"""Pressure quality: flicker, noise, impact convergence, shifting (docs/pressure.md).
+
+usage: bench/pressure_quality.py [--build build] [--before BUILD] [--out DIR]
+                                 [--only flicker,hydro,impact,shifting,validation]
+                                 [--dps 0.008,0.004,0.002] [--img DIR]
+
+--build   the build to measure (its bin/ holds fluid_solver and coupler);
+--before  a build of an earlier commit to compare with in the flicker and
+          validation sections (e.g. one of bea0399, before the flicker fix:
+          `git worktree add /tmp/before bea0399 && cmake -S /tmp/before -B
+          /tmp/before/build -DMPS_TESTS=OFF && cmake --build /tmp/before/build`);
+--out     where the runs go (default: a new directory under /tmp);
+--img     where the plots go (default: OUT; docs/img for the doc's).
+Prints markdown tables. Sections:
+  flicker     share of the interior fluid (not on the free surface) at P = 0
+              in each snapshot, dam break at 4 mm (0.3 s) with output every
+              0.02 and 0.0199 s, coupled plate at 6 mm (2 s); the plate force
+              (2 ms rows) against its 20 ms running mean; the share per step
+              (fluid.step_log) of the runs of --build;
+  hydro       still water (cases/hydrostatic, 10 mm) for 10 s: RMS of
+              P - rho g (y_s - y) over all fluid particles per snapshot, and
+              the time noise of the bottom pressure;
+  impact      dam break at each --dps to 0.45 s: the right-wall sensor p_wall
+              (16 mm above the floor): peak, its time, rise time (10-90%),
+              impulse over the impact, observed order of convergence;
+  shifting    the above (4 mm) with fluid.shifting = 0 against the default,
+              and the cost per particle-step;
+  validation  dam-break front/height errors (4, 2 mm) and the plate's tip
+              against Walhorn (6, 3 mm), --build and --before.
+Runs use OMP_NUM_THREADS=2; the wall times are those of the machine at the
+time (the host is in each summary.json)."""
+import argparse, csv, glob, json, math, os, subprocess, sys, tempfile
+
+import h5py
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+sys.path.insert(0, HERE)
+import dambreak_compare as dc  # noqa: E402
+import plate_compare as pc  # noqa: E402
+
+RHO, G = 1000.0, 9.81
+
+
+def run(binary, case, out, sets, env=None):
+    """Runs a case (fluid_solver or coupler) into out; returns summary.json."""
+    cmd = [binary, os.path.join(ROOT, case), '--out', out, '--quiet']
+    for kv in sets:
+        cmd += ['--set', kv]
+    e = dict(os.environ, OMP_NUM_THREADS='2', **(env or {}))
+    r = subprocess.run(cmd, env=e, cwd=ROOT, stderr=subprocess.PIPE, text=True)
+    summ = os.path.join(out, 'summary.json')
+    if not os.path.exists(summ):
+        raise SystemExit('%s failed (exit %d): %s' % (' '.join(cmd), r.returncode, r.stderr[-400:]))
+    with open(summ) as f:
+        return json.load(f)
+
+
+def probes(run_dir):
+    with open(os.path.join(run_dir, 'probes.csv')) as f:
+        rows = list(csv.reader(l for l in f if not l.startswith('#')))
+    head = rows[0]
+    data = np.array([[float(x) for x in r] for r in rows[1:]])
+    return {h: data[:, k] for k, h in enumerate(head)}
+
+
+def snapshot_shares(run_dir, after=0.05):
+    """(time, share of interior fluid at P = 0) per fluid snapshot."""
+    out = []
+    for fn in sorted(glob.glob(os.path.join(run_dir, 'fluid_*.h5'))):
+        with h5py.File(fn, 'r') as f:
+            t = float(f.attrs['time'])
+            ptype = f['particles/type'][:]
+            p = f['particles/pressure'][:]
+            surf = f['particles/free_surface'][:]
+        interior = (ptype == 0) & (surf == 0)
+        if interior.any():
+            out.append((t, float(np.mean(p[interior] == 0.0))))
+    return [s for s in out if s[0] > after]
+
+
+def step_shares(run_dir, after=0.05):
+    path = glob.glob(os.path.join(run_dir, '*_steps.csv'))
+    if not path:
+        return None
+    s = probes_like(path[0])
+    keep = s['time'] > after
+    return s['time'][keep], s['rows_at_zero'][keep] / np.maximum(s['ppe_rows'][keep], 1)
+
+
+def probes_like(path):
+    with open(path) as f:
+        rows = list(csv.reader(l for l in f if not l.startswith('#')))
+    data = np.array([[float(x) for x in r] for r in rows[1:]])
+    return {h: data[:, k] for k, h in enumerate(rows[0])}
+
+
+def force_smoothness(run_dir):
+    """The plate force rows (mean over each 2 ms probe interval) against
+    their centred 20 ms running mean, after the first impact (|F| above 10%
+    of its peak): share of rows within 15% of the mean (the mean floored at
+    10% of the peak, where the force passes through zero), the RMS of the
+    deviation and the mean change from row to row."""
+    p = probes(run_dir)
+    t, fx = p['time'], p['solid_fx']
+    peak = np.abs(fx).max()
+    t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
+    w = max(1, int(round(0.02 / np.median(np.diff(t)))))
+    mean = np.convolve(fx, np.ones(w) / w, mode='same')
+    m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
+    dev = np.abs(fx - mean)[m]
+    ref = np.maximum(np.abs(mean[m]), 0.1 * peak)
+    return {'first_impact_s': float(t0), 'peak': float(peak), 'within15': float(np.mean(dev <= 0.15 * ref)),
+            'rms_dev': float(np.sqrt(np.mean(dev ** 2))), 'step_change': float(np.mean(np.abs(np.diff(fx[m]))))}
+
+
+def fmt_shares(s):
+    z = [100 * x for _, x in s]
+    return 'max %.1f%% (t = %.3f s), mean %.1f%%, over 5%%: %d of %d' % (
+        max(z), s[int(np.argmax(z))][0], np.mean(z), sum(v > 5 for v in z), len(z))
+
+
+def section_flicker(a, builds):
+    print('\n## Flicker\n')
+    print('| build | run | snapshots after 0.05 s: interior at P = 0 | per step (step log) |')
+    print('|---|---|---|---|')
+    plate_rows = []
+    for name, b in builds:
+        log = ['fluid.step_log=true'] if name == 'after' else []
+        for iv in ('0.02', '0.0199'):
+            out = os.path.join(a.out, 'flicker_db_%s_%s' % (name, iv))
+            run(os.path.join(b, 'bin', 'fluid_solver'), 'cases/dambreak/case.yml', out,
+                ['end_time=0.3', 'output.interval=' + iv] + log)
+            st = step_shares(out)
+            ps = ('mean %.1f%%, over 5%%: %.0f%% of %d steps' % (100 * st[1].mean(), 100 * np.mean(st[1] > 0.05), len(st[1]))
+                  if st else '-')
+            print('| %s | dam break 4 mm, output %s s | %s | %s |' % (name, iv, fmt_shares(snapshot_shares(out)), ps))
+        out = os.path.join(a.out, 'flicker_plate_%s' % name)
+        run(os.path.join(b, 'bin', 'coupler'), 'cases/dambreak_elastic_plate/case.yml', out,
+            ['dp=0.006'] + log)
+        st = step_shares(out)
+        ps = ('mean %.1f%%, over 5%%: %.0f%% of %d steps' % (100 * st[1].mean(), 100 * np.mean(st[1] > 0.05), len(st[1]))
+              if st else '-')
+        print('| %s | plate 6 mm, 2 s | %s | %s |' % (name, fmt_shares(snapshot_shares(out)), ps))
+        plate_rows.append((name, force_smoothness(out), out))
+    print('\nPlate force (`solid_fx`, 2 ms rows) after the first impact:\n')
+    print('| build | first impact | peak (N/m) | rows within 15% of the 20 ms mean | RMS deviation (N/m) | mean change row to row (N/m) |')
+    print('|---|---|---|---|---|---|')
+    for name, m, _ in plate_rows:
+        print('| %s | %.3f s | %.1f | %.0f%% | %.1f | %.1f |' % (name, m['first_impact_s'], m['peak'], 100 * m['within15'],
+                                                         m['rms_dev'], m['step_change']))
+    if a.img:
+        plot_flicker(a, builds, plate_rows)
+
+
+def plot_flicker(a, builds, plate_rows):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4))
+    for name, _ in builds:
+        for iv, ls in (('0.02', '-o'), ('0.0199', '--s')):
+            s = snapshot_shares(os.path.join(a.out, 'flicker_db_%s_%s' % (name, iv)), after=0.0)
+            ax[0].plot([x[0] for x in s], [100 * x[1] for x in s], ls, ms=3, label='%s, output %s s' % (name, iv))
+    ax[0].axhline(5, color='k', lw=0.5)
+    ax[0].set_xlabel('t (s)')
+    ax[0].set_ylabel('interior fluid at P = 0 (%)')
+    ax[0].set_title('dam break, 4 mm: snapshots')
+    ax[0].legend(fontsize=8)
+    for name, _, out in plate_rows:
+        p = probes(out)
+        ax[1].plot(p['time'], p['solid_fx'], lw=0.8, label=name)
+    ax[1].set_xlim(0.1, 0.6)
+    ax[1].set_xlabel('t (s)')
+    ax[1].set_ylabel('plate force, 2 ms mean (N/m)')
+    ax[1].set_title('plate, 6 mm')
+    ax[1].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(a.img, 'pressure_flicker.png'), dpi=90)
+
+
+def section_hydro(a, b):
+    print('\n## Still water, 10 s (cases/hydrostatic, dp = 10 mm)\n')
+    out = os.path.join(a.out, 'hydro10')
+    summ = run(os.path.join(b, 'bin', 'fluid_solver'), 'cases/hydrostatic/case.yml', out,
+               ['end_time=10', 'output.interval=0.5'])
+    dp = 0.01
+    ys = 0.3 - 0.5 * dp   # P = 0 at the top particles' centres
+    rows = []
+    for fn in sorted(glob.glob(os.path.join(out, 'fluid_*.h5'))):
+        with h5py.File(fn, 'r') as f:
+            t = float(f.attrs['time'])
+            ptype = f['particles/type'][:]
+            x = f['particles/position'][:]
+            p = f['particles/pressure'][:]
+        fl = ptype == 0
+        dev = p[fl] - RHO * G * (ys - x[fl, 1])
+        rows.append((t, float(np.sqrt(np.mean(dev ** 2))), float(np.max(np.abs(dev)))))
+    print('spatial noise, RMS of P - rho g (y_s - y) over the fluid: %.2f Pa at t = 0, %.2f-%.2f Pa '
+          'over 0.5-10 s (max |dev| %.1f Pa; rho g h = %.0f Pa)' % (
+              rows[0][1], min(r[1] for r in rows[1:]), max(r[1] for r in rows[1:]),
+              max(r[2] for r in rows[1:]), RHO * G * 0.3))
+    p = probes(out)
+    keep = p['time'] > 0.5
+    for col in [c for c in p if 'pressure' in c or c.startswith('p_')]:
+        v = p[col][keep]
+        print('time noise of `%s` over 0.5-10 s: mean %.1f Pa, std %.2f Pa, range %.1f-%.1f Pa' % (
+            col, v.mean(), v.std(), v.min(), v.max()))
+    print('(%d steps, %s)' % (summ['steps'], summ.get('host', {}).get('cpu', '') if isinstance(summ.get('host'), dict) else ''))
+
+
+def impact_metrics(run_dir, col='p_wall'):
+    p = probes(run_dir)
+    if col not in p:
+        return None
+    t, v = p['time'], p[col]
+    k = int(np.argmax(v))
+    peak, tp = float(v[k]), float(t[k])
+    above = np.nonzero(v[:k + 1] >= 0.1 * peak)[0]
+    t10 = float(t[above[0]]) if len(above) else tp
+    t90 = float(t[np.nonzero(v[:k + 1] >= 0.9 * peak)[0][0]])
+    # the impact: from the first arrival (10% of the peak) to 50 ms later
+    w = (t >= t10) & (t <= t10 + 0.05)
+    impulse = float(np.trapz(v[w], t[w])) if w.sum() > 1 else float('nan')
+    front = p.get('front')
+    arrive = float(t[np.argmax(front >= 0.584 - 1e-9)]) if front is not None and (front >= 0.584 - 1e-9).any() else float('nan')
+    return {'peak': peak, 't_peak': tp, 'rise': t90 - t10, 't_arrive': t10, 'impulse': impulse, 'front_at_wall': arrive}
+
+
+def order(q):
+    """Observed order from three values at dp, dp/2, dp/4."""
+    d1, d2 = q[0] - q[1], q[1] - q[2]
+    if d2 == 0 or d1 == 0 or (d1 > 0) != (d2 > 0):
+        return float('nan')
+    return math.log2(abs(d1) / abs(d2))
+
+
+def impact_runs(a, b, tag, extra):
+    res = []
+    for dp in a.dps:
+        out = os.path.join(a.out, 'impact_%s_%s' % (tag, dp))
+        summ = run(os.path.join(b, 'bin', 'fluid_solver'), 'cases/dambreak/case.yml', out,
+                   ['dp=%s' % dp, 'end_time=0.45', 'output.interval=0'] + extra)
+        res.append((dp, impact_metrics(out), summ, out))
+    return res
+
+
+def section_impact(a, b):
+    print('\n## Impact on the right wall (sensor p_wall, 16 mm above the floor)\n')
+    res = impact_runs(a, b, 'default', [])
+    if res[0][1] is None:
+        print('no p_wall column in the dam-break case: nothing to report')
+        return
+    print('| dp (mm) | first arrival (s) | peak (Pa) | at (s) | rise 10-90% (ms) | impulse over 50 ms (Pa s) | steps | wall s |')
+    print('|---|---|---|---|---|---|---|---|')
+    for dp, m, s, _ in res:
+        print('| %g | %.4f | %.0f | %.4f | %.1f | %.1f | %d | %.1f |' % (
+            1000 * float(dp), m['t_arrive'], m['peak'], m['t_peak'], 1000 * m['rise'], m['impulse'], s['steps'], s['wall_seconds']))
+    if len(res) == 3:
+        for key, name in (('peak', 'peak'), ('t_peak', 'time of peak'), ('impulse', 'impulse'), ('rise', 'rise time')):
+            q = [r[1][key] for r in res]
+            print('%s: successive differences %.4g, %.4g: observed order %.2f' % (name, q[0] - q[1], q[1] - q[2], order(q)))
+    if a.img:
+        import matplotlib
+        matplotlib.use('Agg')
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots(figsize=(7, 4))
+        for dp, _, _, out in res:
+            p = probes(out)
+            ax.plot(p['time'], p['p_wall'], lw=0.8, label='dp = %g mm' % (1000 * float(dp)))
+        ax.set_xlim(0.15, 0.45)
+        ax.set_xlabel('t (s)')
+        ax.set_ylabel('p_wall (Pa)')
+        ax.legend()
+        fig.tight_layout()
+        fig.savefig(os.path.join(a.img, 'pressure_impact.png'), dpi=90)
+
+
+def section_shifting(a, b):
+    print('\n## Particle shifting (4 mm): default (A = 2) against fluid.shifting = 0\n')
+    print('| shifting | snapshots after 0.05 s at P = 0 | per step | p_wall peak (Pa) | impulse (Pa s) | ns per particle-step | steps |')
+    print('|---|---|---|---|---|---|---|')
+    for tag, sets in (('A = 2 (default)', []), ('off', ['fluid.shifting=0'])):
+        out = os.path.join(a.out, 'shift_%s' % ('on' if not sets else 'off'))
+        s = run(os.path.join(b, 'bin', 'fluid_solver'), 'cases/dambreak/case.yml', out,
+                ['end_time=0.45', 'output.interval=0.02', 'fluid.step_log=true'] + sets)
+        st = step_shares(out)
+        m = impact_metrics(out)
+        print('| %s | %s | mean %.1f%%, over 5%%: %.0f%% | %s | %s | %.0f | %d |' % (
+            tag, fmt_shares(snapshot_shares(out)), 100 * st[1].mean(), 100 * np.mean(st[1] > 0.05),
+            '%.0f' % m['peak'] if m else '-', '%.1f' % m['impulse'] if m else '-', s['ns_per_particle_step'], s['steps']))
+        hout = os.path.join(a.out, 'shift_hydro_%s' % ('on' if not sets else 'off'))
+        run(os.path.join(b, 'bin', 'fluid_solver'), 'cases/hydrostatic/case.yml', hout, ['end_time=2', 'output.interval=0'] + sets)
+    print('(still water does not move, so shifting, which scales with the speed, does nothing there)')
+
+
+def section_validation(a, builds):
+    print('\n## Validation, before and after\n')
+    print('| build | run | result |')
+    print('|---|---|---|')
+    for name, b in builds:
+        for dp in ('0.004', '0.002'):
+            out = os.path.join(a.out, 'val_db_%s_%s' % (name, dp))
+            run(os.path.join(b, 'bin', 'fluid_solver'), 'cases/dambreak/case.yml', out,
+                ['dp=' + dp, 'end_time=0.27', 'output.interval=0'])
+            c = dc.compare(out)
+            print('| %s | dam break %g mm, T = 3 | front max %.1f%% mean %.1f%%, height max %.1f%% mean %.1f%% |' % (
+                name, 1000 * float(dp), 100 * c['front_max_rel_err'], 100 * c['front_mean_rel_err'],
+                100 * c['height_max_rel_err'], 100 * c['height_mean_rel_err']))
+        ref = pc.load_ref()
+        for dp in ('0.006', '0.003'):
+            out = os.path.join(a.out, 'val_plate_%s_%s' % (name, dp))
+            run(os.path.join(b, 'bin', 'coupler'), 'cases/dambreak_elastic_plate/case.yml', out, ['dp=' + dp])
+            m = pc.metrics(out, ref, 1.0)
+            print('| %s | plate %g mm, to 1 s | first peak %.2f cm at %.3f s, RMS from Walhorn %.2f cm, inside the references %.0f%% |' % (
+                name, 1000 * float(dp), 100 * m['peak_m'], m['peak_time_s'], 100 * m['rms_vs_walhorn_m'],
+                100 * m['inside_reference_envelope']))
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--build', default=os.path.join(ROOT, 'build'))
+    ap.add_argument('--before')
+    ap.add_argument('--out')
+    ap.add_argument('--img')
+    ap.add_argument('--only', default='flicker,hydro,impact,shifting,validation')
+    ap.add_argument('--dps', default='0.008,0.004,0.002')
+    a = ap.parse_args()
+    a.dps = a.dps.split(',')
+    a.out = a.out or tempfile.mkdtemp(prefix='pressure_quality_')
+    a.img = a.img or a.out
+    os.makedirs(a.out, exist_ok=True)
+    os.makedirs(a.img, exist_ok=True)
+    builds = [('after', os.path.abspath(a.build))]
+    if a.before:
+        builds.insert(0, ('before', os.path.abspath(a.before)))
+    only = a.only.split(',')
+    print('# pressure_quality: runs in %s' % a.out)
+    if 'flicker' in only:
+        section_flicker(a, builds)
+    if 'hydro' in only:
+        section_hydro(a, builds[-1][1])
+    if 'impact' in only:
+        section_impact(a, builds[-1][1])
+    if 'shifting' in only:
+        section_shifting(a, builds[-1][1])
+    if 'validation' in only:
+        section_validation(a, builds)
+
+
+if __name__ == '__main__':
+    main()
