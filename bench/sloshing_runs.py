@@ -210,6 +210,68 @@ def table(rows):
     return '\n'.join(out)
 
 
+def phases(rows, out):
+    """Where the wall time goes, per run: the coupler's split (fluid, solid,
+    messaging), the time per coupling step and per fluid particle-step, and the
+    fluid's phases (fluid_summary.json). A markdown table."""
+    names = ('neighbours', 'predict', 'density', 'ppe_assemble', 'ppe_solve', 'correct')
+    out_rows = ['| run | steps | wall per step | fluid / solid / messaging | ns per fluid '
+                'particle-step | fluid: ' + ' / '.join(names) + ' | PPE iterations per step |',
+                '|---|---|---|---|---|---|---|']
+    for r in rows:
+        if 'missing' in r:
+            continue
+        d = os.path.join(out, r['name'])
+        summ = json.load(open(os.path.join(d, 'summary.json')))
+        fl = json.load(open(os.path.join(d, 'fluid_summary.json')))
+        sp = summ['time_split_seconds']
+        w = summ['wall_seconds']
+        ph = fl['phase_seconds']
+        tot = sum(ph.values())
+        out_rows.append(
+            f"| {r['name']} | {r['steps']:,} | {1e3 * w / max(r['steps'], 1):.1f} ms | "
+            f"{100 * sp['fluid'] / w:.0f}% / {100 * sp['solid'] / w:.0f}% / "
+            f"{100 * sp['messaging'] / w:.0f}% | {fl['ns_per_particle_step']:.0f} | "
+            + ' / '.join(f"{100 * ph[k] / tot:.0f}%" for k in names)
+            + f" | {fl['ppe_iterations_per_step']:.1f} |")
+    return '\n'.join(out_rows)
+
+
+def table_vs_sinusoid(rows, out):
+    """The measured roll against the sinusoid, over the window both runs hold
+    (the table ends at 4.98 s): mean peak-to-peak, crest, valley, period of
+    each, and their relative difference. Lines of markdown."""
+    lines = []
+    by = {r['name']: r for r in rows}
+    for r in rows:
+        if r['motion'] != 'table' or 'missing' in r or r.get('t_reached', 0) < 3.5:
+            continue
+        s = by.get(r['name'].replace('_table', ''))
+        if not s or 'missing' in s:
+            continue
+        lo, hi = EXP[r['case']]['window'][0], min(r['t_reached'], s['t_reached'])
+        got = {}
+        for q in (r, s):
+            p = np.genfromtxt(csv_rows(os.path.join(out, q['name'], 'probes.csv')), delimiter=',',
+                              names=True)
+            cyc = cycles(p['time'], p['tip_dx'], lo, hi)
+            if not cyc:
+                break
+            got[q['motion']] = (float(np.mean([c[2] - c[3] for c in cyc])),
+                                float(np.mean([c[2] for c in cyc])),
+                                float(np.mean([c[3] for c in cyc])),
+                                float(np.mean([c[1] - c[0] for c in cyc])), len(cyc))
+        if len(got) < 2:
+            continue
+        a, b = got['table'], got['sinusoid']
+        lines.append(f"{r['name']} against {s['name']} over {lo:g}-{hi:.2f} s: mean p2p "
+                     f"{a[0] * 100:.2f} / {b[0] * 100:.2f} cm ({100 * (a[0] / b[0] - 1):+.1f}%), "
+                     f"crest {a[1] * 100:+.2f} / {b[1] * 100:+.2f} cm, valley {a[2] * 100:+.2f} / "
+                     f"{b[2] * 100:+.2f} cm, period {a[3]:.3f} / {b[3]:.3f} s "
+                     f"({a[4]} / {b[4]} cycles)")
+    return lines
+
+
 def plot_tip(rows, out, case, path, names=None):
     import matplotlib
     matplotlib.use('Agg')
@@ -218,6 +280,8 @@ def plot_tip(rows, out, case, path, names=None):
     fig, ax = plt.subplots(figsize=(10, 3.8))
     for r in rows:
         if r['case'] != case or 'missing' in r or (names and r['name'] not in names):
+            continue
+        if r['t_reached'] < 1.0:  # a timing run (1 mm): nothing to see at this scale
             continue
         p = np.genfromtxt(csv_rows(os.path.join(out, r['name'], 'probes.csv')), delimiter=',', names=True)
         ax.plot(p['time'], p['tip_dx'] * 100, lw=0.9, label=r['name'])
@@ -264,6 +328,9 @@ def main():
             do_run(n, runs[n], a.out, a.force, a.set)
     rows = [analyse(n, runs[n], a.out) for n in names]
     text = table(rows)
+    extra = table_vs_sinusoid(rows, a.out) + [phases(rows, a.out)]
+    if extra:
+        text += '\n\n' + '\n\n'.join(extra)
     print(text)
     if a.table:
         with open(a.table, 'w') as f:
