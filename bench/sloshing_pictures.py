@@ -71,7 +71,7 @@ def main():
     fl, so = snapshots(a.run, 'fluid'), snapshots(a.run, 'solid')
     n = len(a.times)
     rows = (n + a.cols - 1) // a.cols
-    fig, axs = plt.subplots(rows, a.cols, figsize=(3.2 * a.cols, 2.0 * rows + 0.4), squeeze=False)
+    fig, axs = plt.subplots(rows, a.cols, figsize=(3.2 * a.cols, 2.3 * rows + 0.4), squeeze=False)
     pmax = a.pmax
     for k, t in enumerate(a.times):
         ax = axs[k // a.cols][k % a.cols]
@@ -98,7 +98,7 @@ def main():
             ax.scatter(xs[:, 0], xs[:, 1], s=s, c='tab:orange', lw=0, rasterized=True)
         ax.set_aspect('equal')
         ax.set_xlim(-0.02, W + 0.02)
-        ax.set_ylim(-0.05, 0.5 * H)
+        ax.set_ylim(-0.05, H + 0.02)  # the whole tank: the high filling splashes to the lid
         ax.set_xticks([])
         ax.set_yticks([])
         ax.set_title(f't = {tf:.2f} s, {math.degrees(theta):+.1f} deg', fontsize=9)
