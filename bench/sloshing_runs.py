@@ -224,8 +224,12 @@ def phases(rows, out):
         d = os.path.join(out, r['name'])
         summ = json.load(open(os.path.join(d, 'summary.json')))
         fl = json.load(open(os.path.join(d, 'fluid_summary.json')))
-        sp = summ['time_split_seconds']
+        sp = dict(summ['time_split_seconds'])
         w = summ['wall_seconds']
+        if not sp['fluid']:  # an interrupted run: the coupler has no split, the solvers do
+            so = json.load(open(os.path.join(d, 'solid_summary.json')))
+            sp['fluid'], sp['solid'] = fl['compute_seconds'], so['compute_seconds']
+            sp['messaging'] = w - sp['fluid'] - sp['solid']
         ph = fl['phase_seconds']
         tot = sum(ph.values())
         out_rows.append(
