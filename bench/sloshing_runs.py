@@ -251,19 +251,23 @@ def phases(rows, out):
     return '\n'.join(out_rows)
 
 
-def table_vs_sinusoid(rows, out):
+def table_vs_sinusoid(rows, out, window=None):
     """The measured roll against the sinusoid, over the window both runs hold
-    (the table ends at 4.98 s): mean peak-to-peak, crest, valley, period of
-    each, and their relative difference. Lines of markdown."""
+    (the table ends at 4.98 s; window=(lo, hi) narrows it, e.g. to before a
+    divergence): mean peak-to-peak, crest, valley, period of each, and their
+    relative difference. Lines of markdown."""
     lines = []
     by = {r['name']: r for r in rows}
     for r in rows:
-        if r['motion'] != 'table' or 'missing' in r or r.get('t_reached', 0) < 3.5:
+        if r['motion'] != 'table' or 'missing' in r or (r.get('t_reached', 0) < 3.5 and
+                                                          not window):
             continue
         s = by.get(r['name'].replace('_table', ''))
         if not s or 'missing' in s:
             continue
         lo, hi = EXP[r['case']]['window'][0], min(r['t_reached'], s['t_reached'])
+        if window:
+            lo, hi = window[0], min(hi, window[1])
         got = {}
         for q in (r, s):
             p = probes(os.path.join(out, q['name'], 'probes.csv'))
@@ -326,6 +330,8 @@ def main():
     ap.add_argument('--json', default=None)
     ap.add_argument('--plots', default=None, help='directory for the tip plots')
     ap.add_argument('--list', action='store_true')
+    ap.add_argument('--compare-window', type=float, nargs=2, default=None, metavar=('LO', 'HI'),
+                    help='the measured roll against the sinusoid over LO-HI s')
     a = ap.parse_args()
     runs = run_list()
     if a.list:
@@ -341,7 +347,7 @@ def main():
             do_run(n, runs[n], a.out, a.force, a.set)
     rows = [analyse(n, runs[n], a.out) for n in names]
     text = table(rows)
-    extra = table_vs_sinusoid(rows, a.out) + [phases(rows, a.out)]
+    extra = table_vs_sinusoid(rows, a.out, a.compare_window) + [phases(rows, a.out)]
     if extra:
         text += '\n\n' + '\n\n'.join(extra)
     print(text)
