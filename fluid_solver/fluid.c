@@ -12,7 +12,8 @@
 #include "mps_ops.h"
 
 static const char *const phase_names[PH_COUNT] = {
-    "neighbours", "predict", "density", "ppe_assemble", "ppe_solve", "correct", "other"};
+    "neighbours", "predict", "density", "ppe_assemble", "ppe_solve", "correct", "sensors",
+    "other"};
 
 /* Skin added to the Laplacian radius so one neighbour list serves several
  * steps (a Verlet list): it is rebuilt once some particle has moved more
@@ -161,7 +162,10 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     f->lambda_lap = cl.lambda;
     f->skin = SKIN_FRACTION * prm->dp;
 
-    st = fluid_linsolve_create(&f->ls, prm->ppe_solver, prm->ppe_rtol, prm->ppe_max_iter, 0, err);
+    st = fluid_sensors_create(&f->sens, prm, err);
+    if (!st)
+        st = fluid_linsolve_create(&f->ls, prm->ppe_solver, prm->ppe_rtol, prm->ppe_max_iter, 0,
+                                   err);
     if (!st)
         st = fluid_linsolve_set_drop(f->ls, prm->ppe_drop, err);
     /* fluid_ppe_assemble writes sorted rows with their diagonal */
@@ -197,6 +201,7 @@ void fluid_destroy(struct fluid **pf)
     free(f->rhs);
     free(f->sol);
     fluid_linsolve_destroy(&f->ls);
+    fluid_sensors_destroy(&f->sens);
     free(f);
     *pf = NULL;
 }
@@ -700,6 +705,10 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     st = remove_lost(f, err);
     if (!st)
         st = check_domain(f, err);
+    /* the time means of the sensors and wall loads take every step */
+    mps_timer_switch(&f->timer, PH_SENSORS);
+    if (!st)
+        fluid_sensors_accumulate(f, dt);
     mps_timer_stop(&f->timer);
     return st;
 }

@@ -18,6 +18,7 @@
 
 #include "fluid_linsolve.h"
 #include "fluid_params.h"
+#include "fluid_sensors.h"
 #include "mps_dim.h"
 #include "mps_json.h"
 #include "mps_nbr.h"
@@ -27,7 +28,8 @@
 enum fluid_ptype { FLUID_P = 0, WALL_P = 1, DUMMY_P = 2, SOLID_SURF_P = 3, SOLID_INNER_P = 4 };
 
 enum fluid_phase {
-    PH_NBR, PH_PREDICT, PH_DENSITY, PH_ASSEMBLE, PH_SOLVE, PH_CORRECT, PH_OTHER, PH_COUNT
+    PH_NBR, PH_PREDICT, PH_DENSITY, PH_ASSEMBLE, PH_SOLVE, PH_CORRECT, PH_SENSORS, PH_OTHER,
+    PH_COUNT
 };
 
 /* What the last step did, for the step log (fluid.step_log). */
@@ -108,6 +110,7 @@ struct fluid {
     long wall_guard;       /* times a particle was put back inside the tank */
     struct fluid_step_stats last;
     struct mps_timer timer;
+    struct fluid_sensors *sens;   /* time means of the averaged probes (NULL: none) */
 };
 
 /* Builds the tank and the water blocks from validated parameters. */
@@ -144,8 +147,12 @@ void fluid_update_masks(struct fluid *f);
  * tank, else the moving frame's body acceleration at each particle's x, v. */
 void fluid_body_accel(struct fluid *f, double t);
 
-/* Current value of probe k (see enum fluid_probe_kind). */
+/* Probe k (see enum fluid_probe_kind): the mean since the last
+ * fluid_probes_restart() for the averaged kinds (fluid_sensors.h), the value
+ * now for the others. */
 double fluid_probe(const struct fluid *f, int k);
+/* A probe row was written: the averaged probes start a new interval. */
+void fluid_probes_restart(const struct fluid *f);
 
 /* Output fields for a snapshot; returns the count written into out. */
 int fluid_output_fields(const struct fluid *f, struct mps_field *out, int max);

@@ -104,23 +104,129 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "column name in probes.csv"},
     {"fluid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
-     "front|height|pressure|bottom_pressure|max_speed|escaped|tank_angle", "",
-     "what the probe measures"},
+     "front|height|pressure|bottom_pressure|max_speed|escaped|wall_force|wall_moment|tank_angle",
+     "", "what the probe measures (docs/sensors.md; tank_angle: docs/sloshing.md)"},
     {"fluid.probes.*.x", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
      "probe x (height: column position; pressure: point)"},
     {"fluid.probes.*.y", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
-     "probe y (pressure: point)"},
+     "probe y (pressure: point; wall_moment: the point the moment is taken about)"},
+    {"fluid.probes.*.diameter", MPS_KEY_DOUBLE, NULL, 0, 0, POS, NULL, "m",
+     "pressure: diameter of the sensor's face, over which it averages like a transducer "
+     "(default 4 dp, the smallest that averages a few particles; give it in metres for runs "
+     "at several dp). On a wall it reads the fluid next to the face, not the wall particles "
+     "(their pressure is an average over 3 dp whatever the sensor's size): docs/sensors.md"},
+    {"fluid.probes.*.on", MPS_KEY_ENUM, "auto", 0, 0, 0, "auto|wall|solid|water", "",
+     "pressure: a sensor on the tank wall face through (x, y), on a solid's surface (the "
+     "surface particle nearest (x, y) at the first reading, followed as the body moves), or "
+     "a point in the water; auto: wall if (x, y) is within dp/2 of a wall face, else solid if "
+     "a solid surface particle is within dp, else water"},
+    {"fluid.probes.*.wall", MPS_KEY_ENUM, NULL, 0, 0, 0, "left|right|floor|lid", "",
+     "wall_force, wall_moment: the tank wall (inner faces x = 0, x = width, y = 0, y = height)"},
     {NULL, 0, NULL, 0, 0, 0, NULL, NULL, NULL},
 };
 
 static enum fluid_probe_kind probe_kind(const char *s)
 {
-    static const char *const names[] = {"front",     "height",  "pressure",  "bottom_pressure",
-                                        "max_speed", "escaped", "tank_angle"};
-    for (int k = 0; k < 7; k++)
+    static const char *const names[] = {"front",      "height",      "pressure",
+                                        "bottom_pressure", "max_speed", "escaped",
+                                        "wall_force", "wall_moment", "tank_angle"};
+    for (int k = 0; k < 9; k++)
         if (strcmp(s, names[k]) == 0)
             return (enum fluid_probe_kind)k;
     return FLUID_PROBE_FRONT; /* unreachable: mps_case validated the enum */
+}
+
+const char *const fluid_wall_names[FLUID_NWALLS] = {"left", "right", "floor", "lid"};
+
+static enum fluid_wall wall_index(const char *s)
+{
+    for (int w = 0; w < FLUID_NWALLS; w++)
+        if (strcmp(s, fluid_wall_names[w]) == 0)
+            return (enum fluid_wall)w;
+    return FLUID_WALL_LEFT; /* unreachable: mps_case validated the enum */
+}
+
+/* A pressure sensor on a wall: the wall whose face passes within dp/2 of
+ * (x, y) (the nearest if two do, at a corner), or -1. */
+static int wall_at(const struct fluid_params *p, double x, double y)
+{
+    const double d[FLUID_NWALLS] = {fabs(x), fabs(x - p->tank_w), fabs(y),
+                                    p->tank_lid ? fabs(y - p->tank_h) : INFINITY};
+    int best = -1;
+    for (int w = 0; w < FLUID_NWALLS; w++)
+        if (d[w] <= 0.5 * p->dp && (best < 0 || d[w] < d[best]))
+            best = w;
+    return best;
+}
+
+/* The per-kind keys of probe k: a sensor's diameter, placement and wall, a
+ * wall load's wall. Errors name the key. */
+static enum mps_status read_probe_keys(struct fluid_params *p, const struct mps_case *c, int k,
+                                       struct mps_err *err)
+{
+    struct fluid_probe_def *d = &p->probes[k];
+    char key[64];
+    const int pressure = d->kind == FLUID_PROBE_PRESSURE;
+    const int wall_load = d->kind == FLUID_PROBE_WALL_FORCE || d->kind == FLUID_PROBE_WALL_MOMENT;
+    const int has_d = mps_case_has(c, "fluid.probes.%d.diameter", k);
+    const int has_wall = mps_case_has(c, "fluid.probes.%d.wall", k);
+    if ((has_d && !pressure) || (has_wall && !wall_load)) {
+        snprintf(key, sizeof key, "fluid.probes.%d.%s", k, has_d && !pressure ? "diameter" : "wall");
+        return mps_case_fail(c, err, key, "not a key of a %s probe (%s)",
+                             mps_case_string(c, "fluid.probes.%d.kind", k),
+                             has_d && !pressure ? "diameter is for kind pressure"
+                                                : "wall is for wall_force and wall_moment");
+    }
+    if (wall_load) {
+        snprintf(key, sizeof key, "fluid.probes.%d.kind", k);
+        if (!has_wall)
+            return mps_case_fail(c, err, key, "%s needs fluid.probes.%d.wall "
+                                 "(left|right|floor|lid)",
+                                 mps_case_string(c, "%s", key), k);
+        d->wall = wall_index(mps_case_string(c, "fluid.probes.%d.wall", k));
+        snprintf(key, sizeof key, "fluid.probes.%d.wall", k);
+        if (d->wall == FLUID_WALL_LID && !p->tank_lid)
+            return mps_case_fail(c, err, key, "the tank has no lid (fluid.tank.lid: false)");
+        return MPS_OK;
+    }
+    if (!pressure)
+        return MPS_OK;
+    d->diameter = has_d ? mps_case_double(c, "fluid.probes.%d.diameter", k) : 4.0 * p->dp;
+    const char *on = mps_case_string(c, "fluid.probes.%d.on", k);
+    d->on = strcmp(on, "wall") == 0    ? FLUID_ON_WALL
+            : strcmp(on, "solid") == 0 ? FLUID_ON_SOLID
+            : strcmp(on, "water") == 0 ? FLUID_ON_WATER
+                                       : FLUID_ON_AUTO;
+    const double tol = 0.5 * p->dp, top = p->tank_lid ? p->tank_h + tol : INFINITY;
+    if (d->x < -tol || d->x > p->tank_w + tol || d->y < -tol || d->y > top) {
+        snprintf(key, sizeof key, "fluid.probes.%d.%s", k,
+                 d->x < -tol || d->x > p->tank_w + tol ? "x" : "y");
+        return mps_case_fail(c, err, key, "the sensor (%g, %g) lies outside the tank [0, %g] x "
+                             "[0, %g]", d->x, d->y, p->tank_w, p->tank_h);
+    }
+    int w = wall_at(p, d->x, d->y);
+    snprintf(key, sizeof key, "fluid.probes.%d.on", k);
+    if (d->on == FLUID_ON_WALL && w < 0)
+        return mps_case_fail(c, err, key, "the point (%g, %g) is on no tank wall face (x = 0, "
+                             "x = %g, y = 0%s, within dp/2)", d->x, d->y, p->tank_w,
+                             p->tank_lid ? ", y = height" : "");
+    if (d->on == FLUID_ON_AUTO && w >= 0)
+        d->on = FLUID_ON_WALL;
+    if (d->on != FLUID_ON_WALL)
+        return MPS_OK;
+    d->wall = (enum fluid_wall)w;
+    /* the face must hold the whole sensor: a transducer ends at the corner */
+    const int side = w == FLUID_WALL_LEFT || w == FLUID_WALL_RIGHT;
+    const double s = side ? d->y : d->x, len = side ? p->tank_h : p->tank_w;
+    const double r = 0.5 * d->diameter;
+    if (s - r < -1e-9 * len || s + r > len * (1.0 + 1e-9)) {
+        snprintf(key, sizeof key, "fluid.probes.%d.diameter", k);
+        return mps_case_fail(c, err, key, "the sensor's face [%g, %g] (%s = %g +- %g m) runs past "
+                             "the end of the %s wall [0, %g]: move it or make it smaller%s",
+                             s - r, s + r, side ? "y" : "x", s, r, fluid_wall_names[w], len,
+                             has_d ? "" : " (the default diameter is 4 dp)");
+    }
+    return MPS_OK;
 }
 
 enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case *c,
@@ -273,6 +379,8 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
         p->probes[k].kind = probe_kind(mps_case_string(c, "fluid.probes.%d.kind", k));
         p->probes[k].x = mps_case_double(c, "fluid.probes.%d.x", k);
         p->probes[k].y = mps_case_double(c, "fluid.probes.%d.y", k);
+        if ((st = read_probe_keys(p, c, k, err)))
+            return st;
     }
     return MPS_OK;
 }

@@ -19,20 +19,37 @@ enum fluid_wall_bc { FLUID_WALL_NEUMANN, FLUID_WALL_PPE, FLUID_WALL_SOLID_PPE };
 
 
 
+/* Probe kinds (docs/sensors.md). PRESSURE, WALL_FORCE and WALL_MOMENT are
+ * means over the steps since the previous probe row (fluid_sensors.h); the
+ * others are the value at the step that writes the row. */
 enum fluid_probe_kind {
     FLUID_PROBE_FRONT,       /* x of the leading edge of the water on the floor, m */
     FLUID_PROBE_HEIGHT,      /* water height at x (default: the left wall), m */
-    FLUID_PROBE_PRESSURE,    /* mean pressure of particles within 2 dp of (x, y), Pa */
+    FLUID_PROBE_PRESSURE,    /* pressure sensor of a given diameter at (x, y), Pa */
     FLUID_PROBE_BOTTOM,      /* pressure on the floor (y = 0) under water, Pa */
     FLUID_PROBE_MAX_SPEED,   /* max fluid speed, m/s */
     FLUID_PROBE_ESCAPED,     /* fluid particles outside the tank, count */
+    FLUID_PROBE_WALL_FORCE,  /* normal force on a tank wall, outward positive, N/m */
+    FLUID_PROBE_WALL_MOMENT, /* moment of that force about (x, y), counterclockwise, N m/m */
     FLUID_PROBE_TANK_ANGLE   /* the tank's roll angle theta now (motion.*), deg */
 };
+
+/* The tank's walls, by their inner faces: x = 0, x = width, y = 0, y = height. */
+enum fluid_wall { FLUID_WALL_LEFT, FLUID_WALL_RIGHT, FLUID_WALL_FLOOR, FLUID_WALL_LID,
+                  FLUID_NWALLS };
+
+/* Where a pressure sensor sits (fluid.probes.*.on). AUTO is resolved to WALL
+ * when the case is read (the point on a wall face), to SOLID or WATER at the
+ * first evaluation (a solid surface particle within dp of the point or not). */
+enum fluid_sensor_on { FLUID_ON_AUTO, FLUID_ON_WALL, FLUID_ON_SOLID, FLUID_ON_WATER };
 
 struct fluid_probe_def {
     const char *name;
     enum fluid_probe_kind kind;
     double x, y;
+    double diameter;            /* pressure: sensor face diameter, m */
+    enum fluid_sensor_on on;    /* pressure: where it sits */
+    enum fluid_wall wall;       /* pressure on a wall, wall_force, wall_moment */
 };
 
 struct fluid_params {
@@ -75,6 +92,8 @@ struct fluid_params {
 };
 
 extern const struct mps_key_spec fluid_case_keys[];
+/* "left", "right", "floor", "lid", by enum fluid_wall. */
+extern const char *const fluid_wall_names[FLUID_NWALLS];
 
 /* Reads and cross-checks the fluid keys (blocks inside the tank, CFL cap
  * satisfiable, ...). Errors name file, line and key. */

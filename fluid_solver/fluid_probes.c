@@ -25,23 +25,6 @@ static double probe_height(const struct fluid *f, double x0)
     return isfinite(ymax) ? ymax + 0.5 * f->prm.dp : 0.0;
 }
 
-static double probe_pressure(const struct fluid *f, double x, double y)
-{
-    const double r2max = 4.0 * f->prm.dp * f->prm.dp;
-    double s = 0.0;
-    int m = 0;
-    for (size_t i = 0; i < f->ps.n; i++) {
-        if (!f->has_p[i])
-            continue;
-        double dx = f->x[i][0] - x, dy = f->x[i][1] - y;
-        if (dx * dx + dy * dy < r2max) {
-            s += f->p[i];
-            m++;
-        }
-    }
-    return m ? s / m : 0.0;
-}
-
 static double probe_bottom(const struct fluid *f)
 {
     /* mean over floor wall particles that have water above them (not free
@@ -93,13 +76,20 @@ double fluid_probe(const struct fluid *f, int k)
     switch (d->kind) {
     case FLUID_PROBE_FRONT: return probe_front(f);
     case FLUID_PROBE_HEIGHT: return probe_height(f, d->x);
-    case FLUID_PROBE_PRESSURE: return probe_pressure(f, d->x, d->y);
+    case FLUID_PROBE_PRESSURE:
+    case FLUID_PROBE_WALL_FORCE:
+    case FLUID_PROBE_WALL_MOMENT: return fluid_sensors_value(f, k);
     case FLUID_PROBE_BOTTOM: return probe_bottom(f);
     case FLUID_PROBE_MAX_SPEED: return probe_max_speed(f);
     case FLUID_PROBE_ESCAPED: return probe_escaped(f);
     case FLUID_PROBE_TANK_ANGLE: return probe_tank_angle(f);
     }
     return NAN;
+}
+
+void fluid_probes_restart(const struct fluid *f)
+{
+    fluid_sensors_restart(f);
 }
 
 int fluid_output_fields(const struct fluid *f, struct mps_field *out, int max)
@@ -131,6 +121,7 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
     mps_json_num(j, "step_seconds", total);
     mps_json_num(j, "ns_per_particle_step",
                  f->step ? 1e9 * total / ((double)f->step * (double)f->ps.n) : 0.0);
+    fluid_sensors_summary(f, j);
     mps_json_object(j, "phase_seconds");
     for (int k = 0; k < f->timer.nphases; k++)
         mps_json_num(j, f->timer.names[k], f->timer.seconds[k]);

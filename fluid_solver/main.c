@@ -74,6 +74,7 @@ static enum mps_status write_probes(struct run *r, struct mps_err *err)
     double v[FLUID_MAX_PROBES];
     for (int k = 0; k < r->f->prm.nprobes; k++)
         v[k] = fluid_probe(r->f, k);
+    fluid_probes_restart(r->f);
     return mps_probes_write(r->probes, r->f->time, v, err);
 }
 
@@ -318,6 +319,7 @@ static enum mps_status peer_advance(void *self, const struct proto_msg *in,
         static double values[FLUID_MAX_PROBES];
         for (int k = 0; k < f->prm.nprobes; k++)
             values[k] = fluid_probe(f, k);
+        fluid_probes_restart(f); /* the coupler writes a row of these */
         reply->nprobes = f->prm.nprobes;
         reply->probes = values;
     }

@@ -62,6 +62,7 @@ static enum mps_status write_probes(struct run *r, double t, struct mps_err *err
 {
     for (int k = 0; k < r->nprobes; k++)
         r->pvals[k] = r->ops->probe_value(r->model, k);
+    r->ops->probe_restart(r->model);
     return mps_probes_write(r->probes, t, r->pvals, err);
 }
 

@@ -67,6 +67,9 @@ struct solid_model_ops {
     int (*probe_count)(const void *self);
     const char *(*probe_name)(const void *self, int k);
     double (*probe_value)(const void *self, int k);
+    /* A probe row was written: the probes that are means over time (the
+     * fluid's load on a body, solid_loadprobe.h) start a new interval. */
+    void (*probe_restart)(void *self);
     /* Particle positions and output fields for a snapshot (borrowed). */
     size_t (*snapshot)(void *self, const double (**x)[MPS_DIM], struct mps_field *fields,
                        int max_fields, int *nfields);

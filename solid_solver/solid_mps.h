@@ -62,6 +62,7 @@
 #include "mps_particles.h"
 #include "mps_timer.h"
 #include "solid_iface.h"
+#include "solid_loadprobe.h"
 #include "solid_model.h"
 #include "solid_scene.h"
 
@@ -124,6 +125,7 @@ struct solid_mps {
     int nprobes;
     int probe_n[SOLID_MAX_PROBES];
     size_t probe_i[SOLID_MAX_PROBES][SOLID_MPS_PROBE_MAX];
+    struct solid_load_probes loadprobes; /* force and moment probes (solid_loadprobe.h) */
 
     /* interface cache (solid_model_ops.interface) */
     struct solid_iface_cache iface;

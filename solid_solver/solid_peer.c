@@ -138,6 +138,7 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
         reply->nprobes = p->ops->probe_count(p->model);
         for (int k = 0; k < reply->nprobes; k++)
             p->probes[k] = p->ops->probe_value(p->model, k);
+        p->ops->probe_restart(p->model); /* the coupler writes a row of these */
         reply->probes = p->probes;
     }
     if (in->flags & PROTO_F_SNAPSHOT)

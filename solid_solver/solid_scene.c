@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "mps_budget.h"
+#include "solid_loadprobe.h"
 
 #define ANY (MPS_KEY_NO_LO | MPS_KEY_NO_HI)
 #define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
@@ -70,12 +71,18 @@ const struct mps_key_spec solid_case_keys[] = {
     {"solid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "column name in probes.csv"},
     {"solid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
-     "dx|dy|x|y|tank_angle|energy", "",
-     "displacement or position component"},
+     "dx|dy|x|y|tank_angle|energy|force_x|force_y|moment", "",
+     "displacement or position component of a particle; the tank's roll angle; the solid's "
+     "energy; or the fluid's force on a body, or its moment about (x, y), the mean over the "
+     "time since the previous probe row (docs/sensors.md)"},
     {"solid.probes.*.x", MPS_KEY_DOUBLE, NULL, 0, 0, ANY, NULL, "m",
-     "probe point: the nearest particle(s) at start (kinds dx, dy, x, y)"},
+     "probe point: the nearest particle(s) at start (dx, dy, x, y); the point the moment is "
+     "taken about (moment)"},
     {"solid.probes.*.y", MPS_KEY_DOUBLE, NULL, 0, 0, ANY, NULL, "m",
-     "probe point: the nearest particle(s) at start (kinds dx, dy, x, y)"},
+     "probe point: the nearest particle(s) at start (dx, dy, x, y); the point the moment is "
+     "taken about (moment)"},
+    {"solid.probes.*.body", MPS_KEY_STRING, NULL, 0, 0, 0, NULL, "",
+     "force_x, force_y, moment: the body's name (absent: all bodies together)"},
     {.name = NULL},
 };
 
@@ -125,6 +132,15 @@ static long count_inside(const struct solid_scene *s, int b, double x0, double y
         }
     }
     return k;
+}
+
+/* "plate, post": the bodies' names, for messages. */
+static const char *body_names(const struct solid_scene *s, char *buf, size_t len)
+{
+    buf[0] = '\0';
+    for (int b = 0; b < s->nbodies; b++)
+        snprintf(buf + strlen(buf), len - strlen(buf), "%s%s", b ? ", " : "", s->bodies[b].name);
+    return buf;
 }
 
 static void copy_name(char *dst, const char *src)
@@ -234,11 +250,9 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             if (strcmp(s->bodies[b].name, name) == 0)
                 d->body = b;
         if (d->body < 0) {
-            char names[512] = "";
-            for (int b = 0; b < s->nbodies; b++)
-                snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s",
-                         b ? ", " : "", s->bodies[b].name);
-            return mps_case_fail(c, err, key, "no body of that name (bodies: %s)", names);
+            char names[512];
+            return mps_case_fail(c, err, key, "no body of that name (bodies: %s)",
+                                 body_names(s, names, sizeof names));
         }
         d->x0 = mps_case_double(c, "solid.clamps.%d.x0", k);
         d->y0 = mps_case_double(c, "solid.clamps.%d.y0", k);
@@ -263,21 +277,49 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             return mps_err_set(err, MPS_EINPUT, "%s: solid.probes.%d: missing (a gap in the "
                                "list of probes)", mps_case_path(c), k);
         copy_name(d->name, mps_case_string(c, "%s", key));
+        static const char *const kinds[] = {"dx",     "dy",      "x",       "y",     "tank_angle",
+                                            "energy", "force_x", "force_y", "moment"};
         const char *kind = mps_case_string(c, "solid.probes.%d.kind", k);
-        d->kind = strcmp(kind, "dx") == 0           ? SOLID_PROBE_DX
-                  : strcmp(kind, "dy") == 0         ? SOLID_PROBE_DY
-                  : strcmp(kind, "x") == 0          ? SOLID_PROBE_X
-                  : strcmp(kind, "y") == 0          ? SOLID_PROBE_Y
-                  : strcmp(kind, "tank_angle") == 0 ? SOLID_PROBE_TANK_ANGLE
-                                                    : SOLID_PROBE_ENERGY;
-        int point = d->kind <= SOLID_PROBE_Y;
-        if (point && (!mps_case_has(c, "solid.probes.%d.x", k) ||
-                      !mps_case_has(c, "solid.probes.%d.y", k))) {
-            snprintf(key, sizeof key, "solid.probes.%d.kind", k);
-            return mps_case_fail(c, err, key, "needs the probe point x and y");
+        d->kind = SOLID_PROBE_DX;
+        for (int a = 0; a < (int)(sizeof kinds / sizeof *kinds); a++)
+            if (strcmp(kind, kinds[a]) == 0)
+                d->kind = (enum solid_probe_kind)a;
+        const int load = d->kind >= SOLID_PROBE_FORCE_X;
+        /* a point for the particle kinds and the moment; a force, the tank's
+         * angle and the energy have none */
+        const int nopoint = d->kind == SOLID_PROBE_FORCE_X || d->kind == SOLID_PROBE_FORCE_Y ||
+                            d->kind == SOLID_PROBE_TANK_ANGLE || d->kind == SOLID_PROBE_ENERGY;
+        for (int a = 0; a < 2; a++) {
+            const char *xy = a ? "y" : "x";
+            int has = mps_case_has(c, "solid.probes.%d.%s", k, xy);
+            snprintf(key, sizeof key, "solid.probes.%d.%s", k, has ? xy : "kind");
+            if (!has && !nopoint)
+                return mps_case_fail(c, err, key, "a %s probe needs solid.probes.%d.%s", kind, k,
+                                     xy);
+            if (has && nopoint)
+                return mps_case_fail(c, err, key, "a %s probe has no point (x and y are for "
+                                     "dx, dy, x, y and moment)", kind);
+            double v = has ? mps_case_double(c, "%s", key) : 0.0;
+            if (a)
+                d->y = v;
+            else
+                d->x = v;
         }
-        d->x = point ? mps_case_double(c, "solid.probes.%d.x", k) : 0.0;
-        d->y = point ? mps_case_double(c, "solid.probes.%d.y", k) : 0.0;
+        d->body = -1;
+        snprintf(key, sizeof key, "solid.probes.%d.body", k);
+        if (mps_case_has(c, "%s", key)) {
+            if (!load)
+                return mps_case_fail(c, err, key, "body is for force_x, force_y and moment");
+            const char *name = mps_case_string(c, "%s", key);
+            for (int b = 0; b < s->nbodies; b++)
+                if (strcmp(s->bodies[b].name, name) == 0)
+                    d->body = b;
+            char names[512];
+            if (d->body < 0)
+                return mps_case_fail(c, err, key, "no body of that name (bodies: %s)",
+                                     body_names(s, names, sizeof names));
+        }
+        snprintf(key, sizeof key, "solid.probes.%d.name", k);
         for (int a = 0; a < k; a++)
             if (strcmp(s->probes[a].name, d->name) == 0)
                 return mps_case_fail(c, err, key, "probe name already used by "
@@ -306,8 +348,11 @@ void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x
 
 double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
                          const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
-                         const double (*x0)[MPS_DIM])
+                         const double (*x0)[MPS_DIM], const struct solid_load_probes *lp,
+                         const int *body)
 {
+    if (solid_probe_is_load(s->probes[k].kind))
+        return solid_load_probes_value(lp, s, k, body, x);
     double sum = 0.0;
     for (int a = 0; a < probe_n[k]; a++) {
         size_t i = probe_i[k][a];
@@ -316,7 +361,9 @@ double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
         case SOLID_PROBE_DY: sum += x[i][1] - x0[i][1]; break;
         case SOLID_PROBE_X: sum += x[i][0]; break;
         case SOLID_PROBE_Y: sum += x[i][1]; break;
-        default: return NAN;
+        case SOLID_PROBE_TANK_ANGLE:
+        case SOLID_PROBE_ENERGY: return NAN; /* the model's own (solid_mps.c, solid_tlsph.c) */
+        default: break;                      /* the load kinds, above */
         }
     }
     return probe_n[k] ? sum / probe_n[k] : NAN;

@@ -37,7 +37,12 @@ enum solid_probe_kind {
     SOLID_PROBE_X,          /* x position, m */
     SOLID_PROBE_Y,          /* y position, m */
     SOLID_PROBE_TANK_ANGLE, /* the tank frame's roll angle now (motion.*), deg */
-    SOLID_PROBE_ENERGY      /* kinetic + elastic energy of all bodies, J per m depth */
+    SOLID_PROBE_ENERGY,     /* kinetic + elastic energy of all bodies, J per m depth */
+    /* the fluid's load on a body (or all), mean since the previous probe row
+     * (solid_loadprobe.h); the load kinds come last (solid_scene.c) */
+    SOLID_PROBE_FORCE_X,    /* N per metre depth */
+    SOLID_PROBE_FORCE_Y,
+    SOLID_PROBE_MOMENT      /* about (x, y), counterclockwise positive, N m per metre */
 };
 
 struct solid_body_def {
@@ -55,7 +60,9 @@ struct solid_clamp_def {
 struct solid_probe_def {
     char name[SOLID_NAME_MAX];
     enum solid_probe_kind kind;
-    double x, y;             /* the particle(s) nearest this point at start */
+    double x, y;             /* the particle(s) nearest this point at start; moment: the
+                              * point the moment is taken about */
+    int body;                /* load kinds: index into bodies, -1 all of them */
 };
 
 struct solid_scene {
@@ -89,11 +96,15 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
 void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x0)[MPS_DIM],
                          int *probe_n, size_t (*probe_i)[SOLID_PROBE_TIES]);
 
-/* Probe k's current value: the mean over its particles of dx, dy, x or y
- * (NAN for the kinds the model answers itself: tank_angle, energy). */
+/* Probe k's current value: the mean over its particles of dx, dy, x or y;
+ * for the load kinds, the mean load since the last restart of lp
+ * (solid_loadprobe.h); NAN for the kinds the model answers itself
+ * (tank_angle, energy). body: each particle's body. */
+struct solid_load_probes;
 double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
                          const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
-                         const double (*x0)[MPS_DIM]);
+                         const double (*x0)[MPS_DIM], const struct solid_load_probes *lp,
+                         const int *body);
 
 /* The tank_angle probe: theta at time t in degrees (0 without motion). */
 static inline double solid_probe_tank_angle(const struct mps_motion *m, double t)

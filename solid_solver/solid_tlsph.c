@@ -278,6 +278,7 @@ static void find_probes(struct solid_tlsph *s)
 {
     s->nprobes = s->scene.nprobes;
     solid_probes_locate(&s->scene, s->n, (const double(*)[MPS_DIM])s->x0, s->probe_n, s->probe_i);
+    solid_load_probes_init(&s->loadprobes, &s->scene);
 }
 
 enum mps_status solid_tlsph_create(struct solid_tlsph **out, const struct solid_scene *scene,
@@ -339,6 +340,7 @@ void solid_tlsph_destroy(struct solid_tlsph **sp)
         return;
     struct solid_tlsph *s = *sp;
     mps_particles_free(&s->ps);
+    solid_load_probes_free(&s->loadprobes);
     free(s->pstart);
     free(s->pj);
     if (s->pgl != s->pg)
@@ -586,7 +588,8 @@ double solid_tlsph_probe(const struct solid_tlsph *s, int k)
     default: break;
     }
     return solid_probe_value(&s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
-                             (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0);
+                             (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0,
+                             &s->loadprobes, s->body);
 }
 
 /* ---- solid_model_ops ---- */
@@ -618,12 +621,21 @@ static double op_stable_dt(const void *self)
 static enum mps_status op_set_loads(void *self, const struct solid_loads *f, struct mps_err *err)
 {
     struct solid_tlsph *s = self;
-    return solid_loads_accel(&s->scene, s->body, s->n, f, s->aload, err);
+    enum mps_status st = solid_loads_accel(&s->scene, s->body, s->n, f, s->aload, err);
+    return st ? st : solid_load_probes_set(&s->loadprobes, f, err);
 }
 
 static enum mps_status op_advance(void *self, double dt, struct mps_err *err)
 {
-    return solid_tlsph_advance(self, dt, err);
+    struct solid_tlsph *s = self;
+    /* the loads act over this step from the positions it starts at */
+    solid_load_probes_step(&s->loadprobes, &s->scene, s->body, (const double(*)[MPS_DIM])s->x, dt);
+    return solid_tlsph_advance(s, dt, err);
+}
+
+static void op_probe_restart(void *self)
+{
+    solid_load_probes_restart(&((struct solid_tlsph *)self)->loadprobes);
 }
 
 /* Surface particles and those within depth of one, on the reference lattice
@@ -741,6 +753,7 @@ const struct solid_model_ops solid_tlsph_ops = {
     .probe_count = op_probe_count,
     .probe_name = op_probe_name,
     .probe_value = op_probe_value,
+    .probe_restart = op_probe_restart,
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,

@@ -75,6 +75,7 @@
 #include "mps_particles.h"
 #include "mps_timer.h"
 #include "solid_iface.h"
+#include "solid_loadprobe.h"
 #include "solid_model.h"
 #include "solid_scene.h"
 
@@ -130,6 +131,7 @@ struct solid_tlsph {
     int nprobes;
     int probe_n[SOLID_MAX_PROBES];
     size_t probe_i[SOLID_MAX_PROBES][SOLID_TLSPH_PROBE_MAX];
+    struct solid_load_probes loadprobes; /* force and moment probes (solid_loadprobe.h) */
 
     struct solid_iface_cache iface; /* solid_model_ops.interface */
 

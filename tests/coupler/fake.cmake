@@ -5,7 +5,7 @@ target_link_libraries(fake_solid PRIVATE mpsproto solidcore)
 set_target_properties(fake_solid PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin)
 
 # Integration tests of the coupler (three processes) and its failure handling.
-foreach(t plate_force moving_plate solid_crash solid_hang fluid_killed solid_killed interrupt fluid_fails
+foreach(t plate_force body_loads moving_plate solid_crash solid_hang fluid_killed solid_killed interrupt fluid_fails
           wrong_version cpu_placement stranger run_dir_private external_key)
   add_test(NAME coupler_${t}
            COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/test_coupler.py

@@ -1,8 +1,12 @@
 /* A fake solid for coupling tests (no solid physics): the first body of the
  * case as a rigid lattice of particles moving on a prescribed path
  *   x(t) = x0 + A sin(2 pi f t),
- * that reports the total fluid force it receives as probes. It speaks the
- * protocol through proto_solver like the real solids do.
+ * that reports the total fluid force it receives as probes (plate_fx,
+ * plate_fy: the force of the last step; plate_dx), followed by the case's
+ * solid.probes through the scene-level probe code every solid model uses
+ * (solid_scene.h, solid_loadprobe.h: force_x, force_y, moment as means over
+ * each probe interval). It speaks the protocol through proto_solver like
+ * the real solids do.
  *   fake_solid [--amplitude A] [--frequency F] [--fail-at T] [--version V]
  *              --connect ENDPOINT
  * --fail-at T makes it crash (abort) at time T, for the coupler's failure
@@ -20,7 +24,10 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
+#include "solid_loadprobe.h"
 #include "solid_scene.h"
+
+#define FIXED_PROBES 3
 
 struct fake {
     double amp, freq, fail_at, hang_at;
@@ -31,6 +38,14 @@ struct fake {
     unsigned char *surface, *fixed;
     double force[2];
     double t;
+    /* the case's probes */
+    struct solid_scene scene;
+    int *body;                      /* all 0: the fake is body 0 */
+    int probe_n[SOLID_MAX_PROBES];
+    size_t probe_i[SOLID_MAX_PROBES][SOLID_PROBE_TIES];
+    struct solid_load_probes loadprobes;
+    char names[4096];
+    double probes[FIXED_PROBES + SOLID_MAX_PROBES];
 };
 
 static void place(struct fake *s, double t)
@@ -54,8 +69,12 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     /* motion: a moving case never reaches here (CONFIG motion is refused) */
     const char *const ignore[] = {"fluid.", "coupling.", "motion.", NULL};
     enum mps_status st = mps_case_load(&c, case_path, NULL, 0, tables, 2, ignore, err);
-    if (st)
+    if (!st)
+        st = solid_scene_read(&s->scene, c, err);
+    if (st) {
+        mps_case_destroy(&c);
         return st;
+    }
     s->dp = mps_case_double(c, "dp");
     double b[4] = {mps_case_double(c, "solid.bodies.0.x0"), mps_case_double(c, "solid.bodies.0.y0"),
                    mps_case_double(c, "solid.bodies.0.x1"), mps_case_double(c, "solid.bodies.0.y1")};
@@ -68,7 +87,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     s->v = calloc(s->n, sizeof *s->v);
     s->surface = calloc(s->n, 1);
     s->fixed = calloc(s->n, 1);
-    if (!s->id || !s->x0 || !s->x || !s->v || !s->surface || !s->fixed)
+    s->body = calloc(s->n, sizeof *s->body);
+    if (!s->id || !s->x0 || !s->x || !s->v || !s->surface || !s->fixed || !s->body)
         return mps_err_set(err, MPS_ENOMEM, "fake solid: out of memory");
     size_t k = 0;
     for (long j = 0; j < ny; j++)
@@ -80,6 +100,12 @@ static enum mps_status configure(void *self, const char *case_path, const char *
             s->surface[k] = j > 0 && (i == 0 || i == nx - 1 || j == ny - 1);
         }
     place(s, 0.0);
+    solid_probes_locate(&s->scene, s->n, (const double(*)[2])s->x0, s->probe_n, s->probe_i);
+    solid_load_probes_init(&s->loadprobes, &s->scene);
+    const char *names[FIXED_PROBES + SOLID_MAX_PROBES] = {"plate_fx", "plate_fy", "plate_dx"};
+    for (int q = 0; q < s->scene.nprobes; q++)
+        names[FIXED_PROBES + q] = s->scene.probes[q].name;
+    proto_join_names(names, FIXED_PROBES + s->scene.nprobes, s->names, sizeof s->names);
     (void)out;
     (void)prefix;
     return MPS_OK;
@@ -99,9 +125,10 @@ static void fill_state(struct fake *s, struct proto_msg *m)
 
 static enum mps_status ready(void *self, struct proto_msg *reply, struct mps_err *err)
 {
-    fill_state(self, reply);
-    reply->nprobes = 3;
-    reply->text = "plate_fx,plate_fy,plate_dx";
+    struct fake *s = self;
+    fill_state(s, reply);
+    reply->nprobes = FIXED_PROBES + s->scene.nprobes;
+    reply->text = s->names;
     (void)err;
     return MPS_OK;
 }
@@ -116,23 +143,37 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
         for (;;)
             pause();
     s->force[0] = s->force[1] = 0.0;
-    if (in->payload == PROTO_LOADS)
+    struct solid_loads loads = {0};
+    if (in->payload == PROTO_LOADS) {
         for (size_t k = 0; k < in->count; k++) {
+            if (in->id[k] < 0 || (size_t)in->id[k] >= s->n)
+                return mps_err_set(err, MPS_EINPUT, "fake solid: load on unknown id %d",
+                                   in->id[k]);
             s->force[0] += in->force[k][0];
             s->force[1] += in->force[k][1];
         }
+        loads = (struct solid_loads){in->count, in->id, in->pressure, in->force};
+    }
+    enum mps_status st = solid_load_probes_set(&s->loadprobes, &loads, err);
+    if (st)
+        return st;
+    /* one step of dt from the positions the loads were computed at */
+    solid_load_probes_step(&s->loadprobes, &s->scene, s->body, (const double(*)[2])s->x, in->dt);
     s->t = in->time + in->dt;
     place(s, s->t);
     fill_state(s, reply);
-    static double probes[3];
-    probes[0] = s->force[0];
-    probes[1] = s->force[1];
-    probes[2] = s->x[0][0] - s->x0[0][0];
     if (in->flags & PROTO_F_PROBES) {
-        reply->nprobes = 3;
-        reply->probes = probes;
+        s->probes[0] = s->force[0];
+        s->probes[1] = s->force[1];
+        s->probes[2] = s->x[0][0] - s->x0[0][0];
+        for (int k = 0; k < s->scene.nprobes; k++)
+            s->probes[FIXED_PROBES + k] = solid_probe_value(
+                &s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
+                (const double(*)[2])s->x, (const double(*)[2])s->x0, &s->loadprobes, s->body);
+        solid_load_probes_restart(&s->loadprobes);
+        reply->nprobes = FIXED_PROBES + s->scene.nprobes;
+        reply->probes = s->probes;
     }
-    (void)err;
     return MPS_OK;
 }
 
@@ -183,5 +224,7 @@ int main(int argc, char **argv)
     free(s.v);
     free(s.surface);
     free(s.fixed);
+    free(s.body);
+    solid_load_probes_free(&s.loadprobes);
     return mps_status_exit_code(st);
 }

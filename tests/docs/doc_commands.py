@@ -114,6 +114,9 @@ SHORT = [
      'true', 'the cantilever table: 10 runs of up to 40 particles across, minutes'),
     ('docs/solid_cantilever.md', r'^bench/solid_elastica_ref\.py', r'\g<0> 10 20',
      'the elastica reference at N = 10, 20 (40, 80, 160: minutes)'),
+    ('docs/security.md', r'^(build/fuzz/fuzz_\w+) -runs=\d+ ', r'test ! -x \g<1> || \g<1> -runs=5000 ',
+     'each fuzzer for 5000 inputs (millions: 15 minutes); skipped where the build has no '
+     'fuzzers (MPS_FUZZ=1 and clang)'),
     ('docs/solid_models.md', r'^\s*bench/solid_cantilever\.py --bin build/bin/solid_solver.*\\\n.*$',
      'true', 'the cantilever table of each model: minutes'),
 ]

@@ -22,8 +22,8 @@ static void clamp_probe_test(int rows)
     sc.nclamps = 1;
     sc.clamps[0] = (struct solid_clamp_def){0, -0.03, 0.0, 0.0, rows * 0.01};
     sc.nprobes = 2;
-    sc.probes[0] = (struct solid_probe_def){"tip", SOLID_PROBE_DY, 0.4, 0.5 * rows * 0.01};
-    sc.probes[1] = (struct solid_probe_def){"root_y", SOLID_PROBE_Y, -0.015, 0.0};
+    sc.probes[0] = (struct solid_probe_def){"tip", SOLID_PROBE_DY, 0.4, 0.5 * rows * 0.01, -1};
+    sc.probes[1] = (struct solid_probe_def){"root_y", SOLID_PROBE_Y, -0.015, 0.0, -1};
     struct solid_mps *m = make_model(&sc);
     CHECK(m->n - m->nfree == (size_t)(3 * rows));
     CHECK(m->probe_n[0] == (rows % 2 ? 1 : 2));
