@@ -114,6 +114,9 @@ SHORT = [
      'true', 'the cantilever table: 10 runs of up to 40 particles across, minutes'),
     ('docs/solid_cantilever.md', r'^bench/solid_elastica_ref\.py', r'\g<0> 10 20',
      'the elastica reference at N = 10, 20 (40, 80, 160: minutes)'),
+    ('docs/pressure.md', r'^/usr/bin/python3 bench/pressure_quality\.py .*$',
+     '/usr/bin/python3 bench/pressure_quality.py --only impact --dps 0.008 --out /tmp/pq_short',
+     'the impact section at 8 mm only (the whole page: 40 minutes and a second build)'),
     ('docs/security.md', r'^(build/fuzz/fuzz_\w+) -runs=\d+ ', r'test ! -x \g<1> || \g<1> -runs=5000 ',
      'each fuzzer for 5000 inputs (millions: 15 minutes); skipped where the build has no '
      'fuzzers (MPS_FUZZ=1 and clang)'),
