@@ -369,6 +369,13 @@ int mps_case_has(const struct mps_case *c, const char *fmt, ...)
     abort();
 }
 
+const char *mps_case_text(const struct mps_case *c, const char *fmt, ...)
+{
+    FORMAT_KEY("mps_case_text");
+    const struct entry *e = case_find_entry(c, key);
+    return e ? e->val : NULL;
+}
+
 int mps_case_count(const struct mps_case *c, const char *fmt, ...)
 {
     FORMAT_KEY("mps_case_count");

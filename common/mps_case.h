@@ -28,7 +28,9 @@ enum mps_key_flags {
     MPS_KEY_LO_OPEN = 1 << 1,  /* value > lo (default: value >= lo) */
     MPS_KEY_HI_OPEN = 1 << 2,  /* value < hi (default: value <= hi) */
     MPS_KEY_NO_LO = 1 << 3,    /* no lower bound */
-    MPS_KEY_NO_HI = 1 << 4     /* no upper bound */
+    MPS_KEY_NO_HI = 1 << 4,    /* no upper bound */
+    MPS_KEY_PATH = 1 << 5      /* STRING: a file path, relative to the case file's
+                                * directory; the resolved YAML holds it absolute */
 };
 
 struct mps_key_spec {
@@ -73,6 +75,12 @@ const char *mps_case_string(const struct mps_case *c, const char *fmt, ...)
 
 /* 1 if the key was given in the file or by --set, or has a default. */
 int mps_case_has(const struct mps_case *c, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+
+/* The value of key as written (file or --set), for any key present, declared
+ * or under an ignored prefix (e.g. the solid reading fluid.tank.width for
+ * Eq. 55); NULL if absent. No default is filled in and nothing is parsed. */
+const char *mps_case_text(const struct mps_case *c, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
 
 /* Number of items in the sequence at prefix ("fluid.blocks"): 1 + the largest

@@ -2,6 +2,8 @@
  * (mps_case_resolved_yaml, mps_case_write_resolved in mps_case.h), with
  * where each key came from, which mps_case_load reads back
  * (case_read_origins). */
+/* realpath() is XSI */
+#define _XOPEN_SOURCE 700
 #include "mps_case_priv.h"
 
 #include <errno.h>
@@ -104,13 +106,37 @@ static int write_sbuf(void *data, unsigned char *buf, size_t size)
     return case_sb_add(data, buf, size) == 0;
 }
 
+/* A relative path value (MPS_KEY_PATH) made absolute against the case's
+ * directory, malloc'd; NULL when it needs no change or memory ran out. */
+static char *absolute_path(const struct mps_case *c, const struct entry *e)
+{
+    if (!e->spec || !(e->spec->flags & MPS_KEY_PATH) || !e->val[0] || e->val[0] == '/')
+        return NULL;
+    char *dir = realpath(c->dir, NULL);
+    char *abs = case_xprintf("%s/%s", dir ? dir : c->dir, e->val);
+    free(dir);
+    return abs;
+}
+
 char *mps_case_resolved_yaml(const struct mps_case *c)
 {
     struct entry **v = malloc(((size_t)c->n + 1) * sizeof *v);
-    if (!v)
+    /* copies of the entries, so path values can be made absolute: the
+     * resolved file is read from elsewhere (the coupler's OUT) */
+    struct entry *copy = malloc(((size_t)c->n + 1) * sizeof *copy);
+    char **abs_val = calloc((size_t)c->n + 1, sizeof *abs_val);
+    if (!v || !copy || !abs_val) {
+        free(v);
+        free(copy);
+        free(abs_val);
         return NULL;
-    for (int i = 0; i < c->n; i++)
-        v[i] = &c->e[i];
+    }
+    for (int i = 0; i < c->n; i++) {
+        copy[i] = c->e[i];
+        if ((abs_val[i] = absolute_path(c, &c->e[i])))
+            copy[i].val = abs_val[i];
+        v[i] = &copy[i];
+    }
     qsort(v, (size_t)c->n, sizeof *v, cmp_keys);
 
     struct sbuf out = {0};
@@ -130,6 +156,10 @@ char *mps_case_resolved_yaml(const struct mps_case *c)
              yaml_emitter_flush(&em);
         yaml_emitter_delete(&em);
     }
+    for (int i = 0; i < c->n; i++)
+        free(abs_val[i]);
+    free(abs_val);
+    free(copy);
     free(v);
     if (!ok || !out.s) {
         free(out.s);

@@ -35,6 +35,7 @@
 #include "mps_host.h"
 #include "mps_json.h"
 #include "mps_json_read.h"
+#include "mps_motion.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_prov.h"
@@ -73,9 +74,13 @@ struct peer {
     char model[64];            /* as its HELLO announced it */
 };
 
+/* the case's key tables: common, fluid, solid, coupler, motion */
+#define NTABLES 5
+
 struct coupler {
     struct mps_case *cs;
-    const struct mps_key_spec *const *tables; /* the case's key tables (4) */
+    struct mps_motion *motion; /* the tank's motion, checked before launching */
+    const struct mps_key_spec *const *tables; /* the case's key tables (NTABLES) */
     struct coupler_record rec;
     const char *out;
     struct peer p[NPEERS];
@@ -368,7 +373,7 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     }
     /* the file this solver is about to read records its own run */
     enum mps_status rst = coupler_record_hello(
-        &c->rec, &c->cs, c->tables, 4, k,
+        &c->rec, &c->cs, c->tables, NTABLES, k,
         p->external ? "(external: started by the user)" : p->child.command, p->model, err);
     if (rst)
         return rst;
@@ -376,6 +381,11 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n%s", resolved_case,
              c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0),
              c->implicit ? "rollback=on\n" : "");
+    /* PROTOCOL.md 4: a solver that cannot apply the tank's motion refuses the
+     * key instead of running a fixed tank */
+    if (mps_motion_moving(c->motion))
+        snprintf(cfg + strlen(cfg), sizeof cfg - strlen(cfg), "motion=%s\n",
+                 mps_motion_kind_name(c->motion->kind));
     struct proto_msg conf = proto_msg_make(PROTO_CONFIG);
     conf.text = cfg;
     return proto_link_send(p->sock, &conf, err);
@@ -871,6 +881,11 @@ static void write_summary_json(struct coupler *c, enum mps_status st, const stru
         mps_json_int(&j, "lost_particles",
                      (long long)bye_number(&c->p[FLUID], "lost_particles", 0.0));
     mps_json_str(&j, "cpu_placement", c->cpu_note);
+    if (c->motion) {
+        mps_json_object(&j, "motion");
+        mps_motion_summary(c->motion, &j);
+        mps_json_close(&j);
+    }
     mps_json_str(&j, "transport", c->guard ? "tcp+curve" : "ipc");
     guard_json(c->guard, &j); /* strangers turned away below the protocol */
     mps_json_object(&j, "solvers");
@@ -963,6 +978,7 @@ static void cleanup(struct coupler *c)
     if (c->iter_log)
         fclose(c->iter_log);
     mps_probes_close(&c->probes);
+    mps_motion_destroy(&c->motion);
     mps_case_destroy(&c->cs);
 }
 
@@ -1012,7 +1028,7 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
                                  const struct mps_cli_extra opt[NOPTS], struct mps_err *err)
 {
     enum mps_status st = mps_case_load(&c->cs, cli->case_path, c->rec.sets, c->rec.nsets,
-                                       c->tables, 4, NULL, err);
+                                       c->tables, NTABLES, NULL, err);
     if (st)
         return st;
     c->hello_timeout = mps_case_double(c->cs, "coupling.hello_timeout");
@@ -1052,6 +1068,8 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
         st = solid_scene_read(sc, c->cs, err);
     if (!st && sc && c->p[FLUID].needed)
         st = scene_check_fsi(&fp, sc, c->cs, err);
+    if (!st)
+        st = mps_motion_read(&c->motion, c->cs, err);
     /* implicit coupling iterates on a fixed interface (coupling_iter.h):
      * fracture changes it, and the MPS solid does not roll it back */
     if (!st && c->implicit && !(c->p[FLUID].needed && c->p[SOLID].needed))
@@ -1228,12 +1246,14 @@ int main(int argc, char **argv)
     c.p[FLUID].name = "fluid";
     c.p[SOLID].name = "solid";
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
-                                                 solid_case_keys, coupler_case_keys};
+                                                 solid_case_keys, coupler_case_keys,
+                                                 mps_motion_keys};
     c.tables = tables;
     coupler_record_init(&c.rec, &cli, opt[OPT_SOLID].value, opt[OPT_FLUID].value);
     enum mps_status st = load_case(&c, &cli, opt, &err);
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
+        mps_motion_destroy(&c.motion);
         mps_case_destroy(&c.cs);
         return mps_status_exit_code(st);
     }

@@ -41,6 +41,7 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "vstar", MPS_DIM, MPS_F64, (void **)&f->vstar, "m/s", 0);
     mps_particles_add_field(ps, "laplacian", MPS_DIM, MPS_F64, (void **)&f->lap, "", 0);
     mps_particles_add_field(ps, "grad_p", MPS_DIM, MPS_F64, (void **)&f->grad, "Pa/m", 0);
+    mps_particles_add_field(ps, "body_acc", MPS_DIM, MPS_F64, (void **)&f->acc, "m/s^2", 0);
     mps_particles_add_field(ps, "div_vstar", 1, MPS_F64, (void **)&f->div, "1/s", 0);
     mps_particles_add_field(ps, "ncount", 1, MPS_I32, (void **)&f->ncount, "", 0);
     mps_particles_add_field(ps, "row", 1, MPS_I32, (void **)&f->row, "", 0);
@@ -102,7 +103,7 @@ static void initial_pressure(struct fluid *f)
             if (f->x[i][0] >= bl[0] && f->x[i][0] <= bl[2] && f->x[i][1] <= yt + p->dp && yt > top)
                 top = yt;
         }
-        f->p[i] = isfinite(top) ? -p->rho * p->g[1] * (top - f->x[i][1]) : 0.0;
+        f->p[i] = isfinite(top) ? -p->rho * f->acc[i][1] * (top - f->x[i][1]) : 0.0;
         if (f->p[i] < 0.0)
             f->p[i] = 0.0;
     }
@@ -148,6 +149,7 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     free(pts);
     f->nfluid = nf;
     f->nfixed_end = nf + nw;
+    fluid_body_accel(f, 0.0);
     if (prm->initial_hydrostatic)
         initial_pressure(f);
     fluid_update_masks(f);
@@ -600,6 +602,10 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
      * (the last one, landing on end_time) scales Eq. 23's correction with
      * it (fluid_ppe.c) */
     f->last = (struct fluid_step_stats){.dt = dt, .dt_cfl = fluid_cfl_dt(f)};
+    /* body force at the step's middle (a moving tank's changes in time) */
+    mps_timer_switch(&f->timer, PH_PREDICT);
+    fluid_body_accel(f, f->time + 0.5 * dt);
+
     /* neighbours (Verlet list with skin) */
     mps_timer_switch(&f->timer, PH_NBR);
     if ((st = update_neighbours(f, err)))
@@ -615,7 +621,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     for (size_t i = 0; i < nf; i++)
         for (int d = 0; d < MPS_DIM; d++) {
             double visc = p->nu > 0.0 ? p->nu * f->lap[i][d] : 0.0;
-            f->vstar[i][d] = f->v[i][d] + dt * (visc + p->g[d]);
+            f->vstar[i][d] = f->v[i][d] + dt * (visc + f->acc[i][d]);
             f->x[i][d] += dt * f->vstar[i][d];
         }
     mps_timer_switch(&f->timer, PH_NBR);
@@ -648,7 +654,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 #pragma omp parallel for schedule(static)
         for (size_t i = nf; i < n; i++)
             for (int d = 0; d < MPS_DIM; d++)
-                f->vstar[i][d] = f->v[i][d] + (f->ghost[i] ? dt : 0.0) * p->g[d];
+                f->vstar[i][d] = f->v[i][d] + (f->ghost[i] ? dt : 0.0) * f->acc[i][d];
         struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
         mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
     }

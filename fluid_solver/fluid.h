@@ -53,6 +53,8 @@ struct fluid {
     double (*vstar)[MPS_DIM];
     double (*lap)[MPS_DIM];
     double (*grad)[MPS_DIM];
+    double (*acc)[MPS_DIM];    /* body force per unit mass: gravity, or in a moving tank
+                                * the frame's (mps_motion.h); fluid_body_accel fills it */
     double *p;
     double *div;           /* divergence of v* (mixed PPE source) */
     double *nd;            /* particle number density n* (re_n) */
@@ -141,6 +143,10 @@ size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
 
 /* Recomputes the type masks (has_p, is_fluid) after particle types change. */
 void fluid_update_masks(struct fluid *f);
+
+/* Fills f->acc for every particle at time t (fluid_body.c): prm.g in a fixed
+ * tank, else the moving frame's body acceleration at each particle's x, v. */
+void fluid_body_accel(struct fluid *f, double t);
 
 /* Probe k (see enum fluid_probe_kind): the mean since the last
  * fluid_probes_restart() for the averaged kinds (fluid_sensors.h), the value

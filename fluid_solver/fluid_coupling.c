@@ -65,6 +65,17 @@ static enum mps_status remove_walls_under_solid(struct fluid *f, size_t n, const
     return mps_particles_resize(&f->ps, ntot - drop, err);
 }
 
+/* Inside the tank's walls (below the floor, beside the side walls, above a
+ * lid): a solid clamped into the floor sits there in place of wall and dummy
+ * particles. Its faces there see no fluid, only walls, so as PPE unknowns
+ * they would hold pressures set by nothing but the wall terms; they count
+ * as inner particles instead (number density only, like the dummies). */
+static int in_walls(const struct fluid *f, const double *x)
+{
+    const struct fluid_params *p = &f->prm;
+    return x[1] < 0.0 || x[0] < 0.0 || x[0] > p->tank_w || (p->tank_lid && x[1] > p->tank_h);
+}
+
 enum mps_status fluid_set_solid(struct fluid *f, size_t n, const int *id,
                                 const double (*x)[MPS_DIM], const double (*v)[MPS_DIM],
                                 const unsigned char *surface, struct mps_err *err)
@@ -89,7 +100,7 @@ enum mps_status fluid_set_solid(struct fluid *f, size_t n, const int *id,
         size_t i = f->nfixed_end + k;
         memcpy(f->x[i], x[k], sizeof f->x[i]);
         memcpy(f->v[i], v[k], sizeof f->v[i]);
-        f->type[i] = surface[k] ? SOLID_SURF_P : SOLID_INNER_P;
+        f->type[i] = surface[k] && !in_walls(f, x[k]) ? SOLID_SURF_P : SOLID_INNER_P;
         f->id[i] = id[k];
     }
     fluid_update_masks(f);

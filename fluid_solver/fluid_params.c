@@ -106,8 +106,8 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "column name in probes.csv"},
     {"fluid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
-     "front|height|pressure|bottom_pressure|max_speed|escaped|wall_force|wall_moment", "",
-     "what the probe measures (docs/sensors.md)"},
+     "front|height|pressure|bottom_pressure|max_speed|escaped|wall_force|wall_moment|tank_angle",
+     "", "what the probe measures (docs/sensors.md; tank_angle: docs/sloshing.md)"},
     {"fluid.probes.*.x", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
      "probe x (height: column position; pressure: point)"},
     {"fluid.probes.*.y", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_LO | NOHI, NULL, "m",
@@ -129,9 +129,10 @@ const struct mps_key_spec fluid_case_keys[] = {
 
 static enum fluid_probe_kind probe_kind(const char *s)
 {
-    static const char *const names[] = {"front", "height", "pressure", "bottom_pressure",
-                                        "max_speed", "escaped", "wall_force", "wall_moment"};
-    for (int k = 0; k < 8; k++)
+    static const char *const names[] = {"front",      "height",      "pressure",
+                                        "bottom_pressure", "max_speed", "escaped",
+                                        "wall_force", "wall_moment", "tank_angle"};
+    for (int k = 0; k < 9; k++)
         if (strcmp(s, names[k]) == 0)
             return (enum fluid_probe_kind)k;
     return FLUID_PROBE_FRONT; /* unreachable: mps_case validated the enum */

@@ -5,6 +5,7 @@
 
 #include "mps_case.h"
 #include "mps_dim.h"
+#include "mps_motion.h"
 
 #define FLUID_MAX_BLOCKS 16
 #define FLUID_MAX_PROBES 32
@@ -29,7 +30,8 @@ enum fluid_probe_kind {
     FLUID_PROBE_MAX_SPEED,   /* max fluid speed, m/s */
     FLUID_PROBE_ESCAPED,     /* fluid particles outside the tank, count */
     FLUID_PROBE_WALL_FORCE,  /* normal force on a tank wall, outward positive, N/m */
-    FLUID_PROBE_WALL_MOMENT  /* moment of that force about (x, y), counterclockwise, N m/m */
+    FLUID_PROBE_WALL_MOMENT, /* moment of that force about (x, y), counterclockwise, N m/m */
+    FLUID_PROBE_TANK_ANGLE   /* the tank's roll angle theta now (motion.*), deg */
 };
 
 /* The tank's walls, by their inner faces: x = 0, x = width, y = 0, y = height. */
@@ -84,6 +86,9 @@ struct fluid_params {
     int nprobes;
     struct fluid_probe_def probes[FLUID_MAX_PROBES];
     double output_interval, probe_interval;
+    /* the tank frame's motion (borrowed from the caller, who reads it with
+     * mps_motion_read; fluid_params_read leaves it NULL: a fixed tank) */
+    const struct mps_motion *motion;
 };
 
 extern const struct mps_key_spec fluid_case_keys[];

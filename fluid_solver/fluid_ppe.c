@@ -302,7 +302,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
                 /* c w_ij (P_j - P_i) = c w_ij rho g.(x_j - x_i), to the right */
                 double gx = 0.0;
                 for (int d = 0; d < MPS_DIM; d++)
-                    gx += p->g[d] * (f->x[j][d] - f->x[i][d]);
+                    gx += f->acc[i][d] * (f->x[j][d] - f->x[i][d]);
                 ghost += f->wlap[k] * p->rho * gx;
             }
         }
@@ -458,7 +458,7 @@ void fluid_ppe_boundary_pressure(struct fluid *f)
             for (int d = 0; d < MPS_DIM; d++) {
                 dx[d] = f->x[b][d] - f->x[j][d];
                 r2 += dx[d] * dx[d];
-                gx += p->g[d] * dx[d];
+                gx += f->acc[j][d] * dx[d];
             }
             if (r2 >= re2)
                 continue;

@@ -30,16 +30,23 @@ static double probe_bottom(const struct fluid *f)
     /* mean over floor wall particles that have water above them (not free
      * surface) of their pressure carried hydrostatically from the particle
      * centre (dp/2 below the floor) up to the floor, y = 0: the pressure on
-     * the bottom of the tank */
+     * the bottom of the tank (acc: the body force of the last step) */
     double s = 0.0;
     int m = 0;
     for (size_t i = f->nfluid; i < f->nfixed_end; i++)
         if (f->type[i] == WALL_P && f->x[i][1] < 0.0 && f->x[i][0] > 0.0 &&
             f->x[i][0] < f->prm.tank_w && !f->surface[i]) {
-            s += f->p[i] + f->prm.rho * f->prm.g[1] * (0.0 - f->x[i][1]);
+            s += f->p[i] + f->prm.rho * f->acc[i][1] * (0.0 - f->x[i][1]);
             m++;
         }
     return m ? s / m : 0.0;
+}
+
+static double probe_tank_angle(const struct fluid *f)
+{
+    const double deg = 180.0 / 3.14159265358979323846;
+    return mps_motion_moving(f->prm.motion) ? mps_motion_at(f->prm.motion, f->time).theta * deg
+                                            : 0.0;
 }
 
 static double probe_max_speed(const struct fluid *f)
@@ -75,6 +82,7 @@ double fluid_probe(const struct fluid *f, int k)
     case FLUID_PROBE_BOTTOM: return probe_bottom(f);
     case FLUID_PROBE_MAX_SPEED: return probe_max_speed(f);
     case FLUID_PROBE_ESCAPED: return probe_escaped(f);
+    case FLUID_PROBE_TANK_ANGLE: return probe_tank_angle(f);
     }
     return NAN;
 }

@@ -35,6 +35,7 @@ static void on_signal(int sig)
 
 struct run {
     struct mps_case *cs;
+    struct mps_motion *motion; /* the tank's motion; the fluid borrows it */
     struct fluid *f;
     struct mps_h5_series *h5;
     struct mps_probes *probes;
@@ -126,6 +127,11 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
         mps_json_str(&j, "cpu_binding", r->cpu_note);
     /* the vector paths set the last bits of the results (MPS_SIMD=sse2) */
     mps_json_str(&j, "simd_paths", mps_simd_wide() ? "avx512" : "portable");
+    if (r->motion) {
+        mps_json_object(&j, "motion");
+        mps_motion_summary(r->motion, &j);
+        mps_json_close(&j);
+    }
     if (r->f)
         fluid_summary(r->f, &j);
     mps_json_end(&j);
@@ -212,7 +218,8 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
 static enum mps_status setup(struct run *r, const char *case_path, const char *const *sets,
                              int nsets, const char *prefix, struct mps_err *err)
 {
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"solid.", "coupling.", NULL};
     /* standalone: this command is the run's record; under the coupler the
      * resolved case brings the coupler's */
@@ -222,10 +229,13 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
         all[nall++] = sets[k];
     if (!r->coupled)
         mps_prov_sets(all, &nall, MPS_CLI_MAX_SETS + MPS_PROV_NSETS);
-    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, tables, 2, ignore, err);
+    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, tables, 3, ignore, err);
     struct fluid_params prm;
-    if (st || (st = fluid_params_read(&prm, r->cs, err)) || (st = mps_mkdir_p(r->out, err)) ||
-        (st = fluid_create(&r->f, &prm, err)))
+    if (st || (st = fluid_params_read(&prm, r->cs, err)) ||
+        (st = mps_motion_read(&r->motion, r->cs, err)) || (st = mps_mkdir_p(r->out, err)))
+        return st;
+    prm.motion = r->motion;
+    if ((st = fluid_create(&r->f, &prm, err)))
         return st;
     char *yaml = mps_case_resolved_yaml(r->cs);
     char path[4200];
@@ -354,6 +364,7 @@ static void teardown(struct run *r)
     mps_h5_close(&r->h5);
     fluid_destroy(&r->f);
     fluid_ckpt_free(&r->ckpt);
+    mps_motion_destroy(&r->motion);
     mps_case_destroy(&r->cs);
     free(r->load_id);
     free(r->load_p);
@@ -367,7 +378,7 @@ static int run_coupled(const char *endpoint, int hello_timeout_ms)
     struct mps_err err = {0};
     static const struct proto_solver_ops ops = {"fluid",     "mps",       peer_configure,
                                                 peer_ready,  peer_advance, peer_finish,
-                                                peer_save,   peer_restore};
+                                                peer_save,   peer_restore, 1};
     enum mps_status st =
         proto_solver_run(endpoint, &ops, &r, hello_timeout_ms, &stop_signal, &r.peer, &err);
     if (st)

@@ -177,6 +177,18 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
             int ok = len == 0;
             for (int k = 0; k < (can_roll ? 5 : 4) && !ok; k++)
                 ok = strlen(known[k]) == klen && strncmp(line, known[k], klen) == 0;
+            if (!ok && klen == 6 && strncmp(line, "motion", 6) == 0) {
+                /* PROTOCOL.md 4: the case's tank moves; a solver that cannot
+                 * apply the moving frame says so rather than run a fixed tank */
+                if (!ops->moving_frame) {
+                    st = mps_err_set(err, MPS_EINPUT,
+                                     "CONFIG %.*s: this %s solver (%s) cannot apply a moving "
+                                     "tank frame (the case's motion block)",
+                                     (int)len, line, ops->role, ops->model);
+                    goto fail;
+                }
+                ok = 1;
+            }
             if (!ok) {
                 st = mps_err_set(err, MPS_EINPUT, "CONFIG key '%.*s' unknown", (int)klen, line);
                 goto fail;

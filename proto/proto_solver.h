@@ -38,6 +38,10 @@ struct proto_solver_ops {
      * iteration > 0. */
     enum mps_status (*save)(void *self, struct mps_err *err);
     enum mps_status (*restore)(void *self, struct mps_err *err);
+    /* 1: the solver applies the case's tank motion (the motion.* keys,
+     * mps_motion.h), so it accepts CONFIG motion=KIND; 0: it answers that key
+     * with ERROR input (PROTOCOL.md 4). */
+    int moving_frame;
 };
 
 /* Timing of the conversation, for the solver's summary. */

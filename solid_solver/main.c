@@ -118,7 +118,8 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
                            struct mps_err *err)
 {
     double wall_start = mps_wall_seconds();
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
     if (model_name && !solid_model_find(model_name))
         return mps_err_set(err, MPS_EINPUT, "--model %s: unknown solid model (known: %s)",
@@ -136,7 +137,7 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     }
     mps_prov_sets(sets, &nsets, MPS_CLI_MAX_SETS + 1 + MPS_PROV_NSETS);
     struct mps_case *c = NULL;
-    enum mps_status st = mps_case_load(&c, cli->case_path, sets, nsets, tables, 2, ignore, err);
+    enum mps_status st = mps_case_load(&c, cli->case_path, sets, nsets, tables, 3, ignore, err);
     if (st != MPS_OK)
         return st;
     struct run r = {0};

@@ -279,6 +279,7 @@ void solid_mps_destroy(struct solid_mps **sp)
     free(s->wold);
     mps_particles_ckpt_free(&s->ckpt);
     solid_iface_cache_free(&s->iface);
+    mps_motion_destroy(&s->motion);
     free(s);
     *sp = NULL;
 }
@@ -345,6 +346,12 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
     double *omega = s->omega, *theta = s->theta;
     const double gx = s->scene.g[0], gy = s->scene.g[1];
     const double spin = 3.0 / (s->dp * s->dp); /* rho V / (2 I), Eq. 43-44 */
+    /* a moving tank: the frame's body force (mps_motion.h) at mid-step; a
+     * particle's spin is relative to the frame, whose own angular
+     * acceleration it then lags: -omega_dot */
+    const int moving = mps_motion_moving(s->motion);
+    const struct mps_motion_frame fr =
+        moving ? mps_motion_at(s->motion, s->time + 0.5 * dt) : (struct mps_motion_frame){0};
 
     mps_timer_switch(&s->timer, SOLID_PH_STRAIN);
     if (s->nden)
@@ -383,9 +390,14 @@ enum mps_status solid_mps_advance(struct solid_mps *s, double dt, struct mps_err
             ay += k * uy - f * ry;
             tq += k * (rx * uy - ry * ux); /* Eq. 41-43 */
         }
-        v[i][0] += dt * (ax + gx + aload[i][0]); /* Eq. 39 */
-        v[i][1] += dt * (ay + gy + aload[i][1]);
+        double b[MPS_DIM] = {gx, gy};
+        if (moving)
+            mps_motion_accel(&fr, x[i], v[i], b);
+        v[i][0] += dt * (ax + b[0] + aload[i][0]); /* Eq. 39 */
+        v[i][1] += dt * (ay + b[1] + aload[i][1]);
         omega[i] += dt * spin * tq; /* Eq. 45 */
+        if (moving)
+            omega[i] -= dt * fr.omega_dot;
     }
     if (s->frac && s->scene.contact != SOLID_CONTACT_NONE) {
         mps_timer_switch(&s->timer, SOLID_PH_CONTACT);
@@ -458,6 +470,12 @@ void solid_mps_diag(const struct solid_mps *s, struct solid_mps_diag *dg)
 
 double solid_mps_probe(const struct solid_mps *s, int k)
 {
+    struct solid_mps_diag d;
+    switch (s->scene.probes[k].kind) {
+    case SOLID_PROBE_TANK_ANGLE: return solid_probe_tank_angle(s->motion, s->time);
+    case SOLID_PROBE_ENERGY: solid_mps_diag(s, &d); return d.kinetic + d.elastic;
+    default: break;
+    }
     return solid_probe_value(&s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
                              (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0,
                              &s->loadprobes, s->body);
@@ -474,6 +492,8 @@ static enum mps_status op_create(void **self, const struct mps_case *c, struct m
     struct solid_mps *s = NULL;
     if (st == MPS_OK)
         st = solid_mps_create(&s, sc, err);
+    if (st == MPS_OK && (st = mps_motion_read(&s->motion, c, err)))
+        solid_mps_destroy(&s);
     free(sc);
     *self = s;
     return st;
@@ -577,6 +597,11 @@ static void op_summary(const void *self, struct mps_json *j)
 {
     const struct solid_mps *s = self;
     mps_json_str(j, "model", "mps");
+    if (s->motion) {
+        mps_json_object(j, "motion");
+        mps_motion_summary(s->motion, j);
+        mps_json_close(j);
+    }
     mps_json_int(j, "bonds", (long long)s->nbonds);
     mps_json_int(j, "fixed_particles", (long long)(s->n - s->nfree));
     mps_json_num(j, "dt_stable", solid_mps_stable_dt(s));

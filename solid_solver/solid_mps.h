@@ -131,6 +131,10 @@ struct solid_mps {
     struct solid_iface_cache iface;
     long iface_rev;                  /* surface_rev the cache was built for */
 
+    /* the tank frame's motion (owned; NULL or kind none: a fixed frame with
+     * the scene's gravity); each step takes its body force at mid-step */
+    struct mps_motion *motion;
+
     double time;
     long steps;
     struct mps_timer timer;

@@ -67,7 +67,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
 {
     struct peer *p = self;
     snprintf(p->out, sizeof p->out, "%s", out);
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
     /* --model NAME is solid.model, so the snapshots' /config says what runs */
     char model_set[64];
@@ -75,7 +76,7 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     if (p->ops)
         snprintf(model_set, sizeof model_set, "solid.model=%s", p->ops->name);
     enum mps_status st =
-        mps_case_load(&p->cs, case_path, sets, p->ops ? 1 : 0, tables, 2, ignore, err);
+        mps_case_load(&p->cs, case_path, sets, p->ops ? 1 : 0, tables, 3, ignore, err);
     if (st)
         return st;
     if (!p->ops && !(p->ops = solid_model_find(mps_case_string(p->cs, "solid.model"))))
@@ -230,7 +231,7 @@ int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int 
     /* every model of this program can roll back (a scene that cannot is
      * refused by its save) */
     struct proto_solver_ops pops = {"solid", ops ? ops->name : "case", configure, ready, advance,
-                                    finish, save, restore};
+                                    finish, save, restore, 1};
     struct mps_err err = {0};
     enum mps_status st =
         proto_solver_run(endpoint, &pops, &p, hello_timeout_ms, stop_flag, &p.stats, &err);

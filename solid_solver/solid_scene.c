@@ -71,10 +71,10 @@ const struct mps_key_spec solid_case_keys[] = {
     {"solid.probes.*.name", MPS_KEY_STRING, NULL, 0, 0, MPS_KEY_REQUIRED, NULL, "",
      "column name in probes.csv"},
     {"solid.probes.*.kind", MPS_KEY_ENUM, NULL, 0, 0, MPS_KEY_REQUIRED,
-     "dx|dy|x|y|force_x|force_y|moment", "",
-     "displacement or position component of a particle; or the fluid's force on a body, or "
-     "its moment about (x, y), the mean over the time since the previous probe row "
-     "(docs/sensors.md)"},
+     "dx|dy|x|y|tank_angle|energy|force_x|force_y|moment", "",
+     "displacement or position component of a particle; the tank's roll angle; the solid's "
+     "energy; or the fluid's force on a body, or its moment about (x, y), the mean over the "
+     "time since the previous probe row (docs/sensors.md)"},
     {"solid.probes.*.x", MPS_KEY_DOUBLE, NULL, 0, 0, ANY, NULL, "m",
      "probe point: the nearest particle(s) at start (dx, dy, x, y); the point the moment is "
      "taken about (moment)"},
@@ -277,23 +277,26 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
             return mps_err_set(err, MPS_EINPUT, "%s: solid.probes.%d: missing (a gap in the "
                                "list of probes)", mps_case_path(c), k);
         copy_name(d->name, mps_case_string(c, "%s", key));
-        static const char *const kinds[] = {"dx", "dy", "x", "y", "force_x", "force_y",
-                                            "moment"};
+        static const char *const kinds[] = {"dx",     "dy",      "x",       "y",     "tank_angle",
+                                            "energy", "force_x", "force_y", "moment"};
         const char *kind = mps_case_string(c, "solid.probes.%d.kind", k);
         d->kind = SOLID_PROBE_DX;
         for (int a = 0; a < (int)(sizeof kinds / sizeof *kinds); a++)
             if (strcmp(kind, kinds[a]) == 0)
                 d->kind = (enum solid_probe_kind)a;
         const int load = d->kind >= SOLID_PROBE_FORCE_X;
-        /* a point for the particle kinds and the moment; a force has none */
+        /* a point for the particle kinds and the moment; a force, the tank's
+         * angle and the energy have none */
+        const int nopoint = d->kind == SOLID_PROBE_FORCE_X || d->kind == SOLID_PROBE_FORCE_Y ||
+                            d->kind == SOLID_PROBE_TANK_ANGLE || d->kind == SOLID_PROBE_ENERGY;
         for (int a = 0; a < 2; a++) {
             const char *xy = a ? "y" : "x";
             int has = mps_case_has(c, "solid.probes.%d.%s", k, xy);
             snprintf(key, sizeof key, "solid.probes.%d.%s", k, has ? xy : "kind");
-            if (!has && d->kind != SOLID_PROBE_FORCE_X && d->kind != SOLID_PROBE_FORCE_Y)
+            if (!has && !nopoint)
                 return mps_case_fail(c, err, key, "a %s probe needs solid.probes.%d.%s", kind, k,
                                      xy);
-            if (has && (d->kind == SOLID_PROBE_FORCE_X || d->kind == SOLID_PROBE_FORCE_Y))
+            if (has && nopoint)
                 return mps_case_fail(c, err, key, "a %s probe has no point (x and y are for "
                                      "dx, dy, x, y and moment)", kind);
             double v = has ? mps_case_double(c, "%s", key) : 0.0;
@@ -330,6 +333,9 @@ void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x
 {
     for (int k = 0; k < s->nprobes; k++) {
         const struct solid_probe_def *p = &s->probes[k];
+        probe_n[k] = 0;
+        if (p->kind > SOLID_PROBE_Y)
+            continue; /* not a point probe */
         double best = INFINITY;
         for (size_t i = 0; i < n; i++)
             best = fmin(best, hypot(x0[i][0] - p->x, x0[i][1] - p->y));
@@ -355,11 +361,14 @@ double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
         case SOLID_PROBE_DY: sum += x[i][1] - x0[i][1]; break;
         case SOLID_PROBE_X: sum += x[i][0]; break;
         case SOLID_PROBE_Y: sum += x[i][1]; break;
-        default: break; /* the load kinds, above */
+        case SOLID_PROBE_TANK_ANGLE:
+        case SOLID_PROBE_ENERGY: return NAN; /* the model's own (solid_mps.c, solid_tlsph.c) */
+        default: break;                      /* the load kinds, above */
         }
     }
     return probe_n[k] ? sum / probe_n[k] : NAN;
 }
+
 
 enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, size_t n,
                                   const struct solid_loads *f, double (*aload)[MPS_DIM],

@@ -7,6 +7,7 @@
 
 #include "mps_case.h"
 #include "mps_dim.h"
+#include "mps_motion.h"
 #include "mps_err.h"
 #include "solid_model.h"
 
@@ -31,15 +32,17 @@ enum solid_plane { SOLID_PLANE_STRAIN, SOLID_PLANE_STRESS };
 enum solid_contact { SOLID_CONTACT_NONE, SOLID_CONTACT_BODIES, SOLID_CONTACT_ALL };
 
 enum solid_probe_kind {
-    SOLID_PROBE_DX,      /* x displacement, m */
-    SOLID_PROBE_DY,      /* y displacement, m */
-    SOLID_PROBE_X,       /* x position, m */
-    SOLID_PROBE_Y,       /* y position, m */
+    SOLID_PROBE_DX,         /* x displacement, m */
+    SOLID_PROBE_DY,         /* y displacement, m */
+    SOLID_PROBE_X,          /* x position, m */
+    SOLID_PROBE_Y,          /* y position, m */
+    SOLID_PROBE_TANK_ANGLE, /* the tank frame's roll angle now (motion.*), deg */
+    SOLID_PROBE_ENERGY,     /* kinetic + elastic energy of all bodies, J per m depth */
     /* the fluid's load on a body (or all), mean since the previous probe row
-     * (solid_loadprobe.h) */
-    SOLID_PROBE_FORCE_X, /* N per metre depth */
+     * (solid_loadprobe.h); the load kinds come last (solid_scene.c) */
+    SOLID_PROBE_FORCE_X,    /* N per metre depth */
     SOLID_PROBE_FORCE_Y,
-    SOLID_PROBE_MOMENT   /* about (x, y), counterclockwise positive, N m per metre */
+    SOLID_PROBE_MOMENT      /* about (x, y), counterclockwise positive, N m per metre */
 };
 
 struct solid_body_def {
@@ -95,12 +98,20 @@ void solid_probes_locate(const struct solid_scene *s, size_t n, const double (*x
 
 /* Probe k's current value: the mean over its particles of dx, dy, x or y;
  * for the load kinds, the mean load since the last restart of lp
- * (solid_loadprobe.h). body: each particle's body. */
+ * (solid_loadprobe.h); NAN for the kinds the model answers itself
+ * (tank_angle, energy). body: each particle's body. */
 struct solid_load_probes;
 double solid_probe_value(const struct solid_scene *s, int k, const int *probe_n,
                          const size_t (*probe_i)[SOLID_PROBE_TIES], const double (*x)[MPS_DIM],
                          const double (*x0)[MPS_DIM], const struct solid_load_probes *lp,
                          const int *body);
+
+/* The tank_angle probe: theta at time t in degrees (0 without motion). */
+static inline double solid_probe_tank_angle(const struct mps_motion *m, double t)
+{
+    return mps_motion_moving(m) ? mps_motion_at(m, t).theta * (180.0 / 3.14159265358979323846)
+                                : 0.0;
+}
 
 /* Fluid loads (force per particle, N per metre depth) as accelerations:
  * aload[i] = force / (rho_body V), V = dp^2; particles not listed get zero.

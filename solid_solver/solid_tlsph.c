@@ -352,6 +352,7 @@ void solid_tlsph_destroy(struct solid_tlsph **sp)
     free(s->pw);
     free(s->pwr);
     solid_iface_cache_free(&s->iface);
+    mps_motion_destroy(&s->motion);
     free(s);
     *sp = NULL;
 }
@@ -463,6 +464,10 @@ enum mps_status solid_tlsph_advance(struct solid_tlsph *s, double dt, struct mps
     const unsigned char *fixed = s->fixed;
     const struct solid_tlsph_material *mat = s->mat;
     const double gx = s->scene.g[0], gy = s->scene.g[1];
+    /* a moving tank: the frame's body force (mps_motion.h) at mid-step */
+    const int moving = mps_motion_moving(s->motion);
+    const struct mps_motion_frame fr =
+        moving ? mps_motion_at(s->motion, s->time + 0.5 * dt) : (struct mps_motion_frame){0};
 
     mps_timer_switch(&s->timer, SOLID_TL_STRAIN);
     solid_tlsph_deform(s);
@@ -496,9 +501,11 @@ enum mps_status solid_tlsph_advance(struct solid_tlsph *s, double dt, struct mps
             cx += vr * rx;
             cy += vr * ry;
         }
-        double ir = 1.0 / m->rho;
-        acc[i][0] = sx * ir + m->kh * hx + m->kv * cx + gx + aload[i][0];
-        acc[i][1] = sy * ir + m->kh * hy + m->kv * cy + gy + aload[i][1];
+        double ir = 1.0 / m->rho, b[MPS_DIM] = {gx, gy};
+        if (moving)
+            mps_motion_accel(&fr, x[i], v[i], b);
+        acc[i][0] = sx * ir + m->kh * hx + m->kv * cx + b[0] + aload[i][0];
+        acc[i][1] = sy * ir + m->kh * hy + m->kv * cy + b[1] + aload[i][1];
     }
 
     mps_timer_switch(&s->timer, SOLID_TL_UPDATE);
@@ -575,6 +582,12 @@ void solid_tlsph_diag(const struct solid_tlsph *s, struct solid_tlsph_diag *d)
 
 double solid_tlsph_probe(const struct solid_tlsph *s, int k)
 {
+    struct solid_tlsph_diag d;
+    switch (s->scene.probes[k].kind) {
+    case SOLID_PROBE_TANK_ANGLE: return solid_probe_tank_angle(s->motion, s->time);
+    case SOLID_PROBE_ENERGY: solid_tlsph_diag(s, &d); return d.kinetic + d.elastic + d.hourglass;
+    default: break;
+    }
     return solid_probe_value(&s->scene, k, s->probe_n, (const size_t(*)[SOLID_PROBE_TIES])s->probe_i,
                              (const double(*)[MPS_DIM])s->x, (const double(*)[MPS_DIM])s->x0,
                              &s->loadprobes, s->body);
@@ -594,6 +607,8 @@ static enum mps_status op_create(void **self, const struct mps_case *c, struct m
             &s, sc, mps_case_double(c, "solid.tlsph.alpha"),
             mps_case_double(c, "solid.tlsph.hourglass"),
             strcmp(mps_case_string(c, "solid.tlsph.correction"), "quadratic") == 0, err);
+    if (st == MPS_OK && (st = mps_motion_read(&s->motion, c, err)))
+        solid_tlsph_destroy(&s);
     free(sc);
     *self = s;
     return st;
@@ -690,6 +705,11 @@ static void op_summary(const void *self, struct mps_json *j)
 {
     const struct solid_tlsph *s = self;
     mps_json_str(j, "model", "tlsph");
+    if (s->motion) {
+        mps_json_object(j, "motion");
+        mps_motion_summary(s->motion, j);
+        mps_json_close(j);
+    }
     mps_json_int(j, "pairs", (long long)s->npairs);
     mps_json_int(j, "fixed_particles", (long long)(s->n - s->nfree));
     mps_json_num(j, "dt_stable", solid_tlsph_stable_dt(s));

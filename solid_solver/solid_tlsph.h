@@ -135,6 +135,10 @@ struct solid_tlsph {
 
     struct solid_iface_cache iface; /* solid_model_ops.interface */
 
+    /* the tank frame's motion (owned; NULL or kind none: a fixed frame with
+     * the scene's gravity); each step takes its body force at mid-step */
+    struct mps_motion *motion;
+
     double time;
     long steps;
     struct mps_timer timer;

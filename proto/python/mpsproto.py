@@ -47,6 +47,12 @@ F_PROBES = 4
 STATUS_NAMES = ("input", "io", "memory", "library", "solver", "diverged", "protocol",
                 "timeout", "peer", "interrupted")
 
+# CONFIG keys (PROTOCOL.md 4). A solver answers a key it does not know with
+# ERROR "input: ...". "motion" (value: the case's motion.kind) is sent only
+# when the case's tank moves: a solver that cannot apply the moving frame's
+# body forces (the case's motion block, docs/sloshing.md) refuses it.
+CONFIG_KEYS = ("case", "out", "prefix", "timeout_ms", "rollback", "motion")
+
 
 class Type(enum.IntEnum):
     HELLO = 1

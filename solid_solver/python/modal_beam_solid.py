@@ -103,9 +103,6 @@ class Fail(Exception):
         super().__init__(f'{status}: {message}')
 
 
-CONFIG_KEYS = ('case', 'out', 'prefix', 'timeout_ms', 'rollback')
-
-
 class Snapshots:
     """OUT/PREFIX_NNNNNN.h5 and the index OUT/PREFIX.xmf, as common/mps_h5.c
     writes them (vectors with 3 components, z = 0; the index one element per
@@ -187,7 +184,12 @@ def converse(sock, courant, t_wall):
         raise Fail('protocol', f'expected CONFIG or REJECT after HELLO, got {mp.Type(cfg.type).name}')
     conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
     for k in conf:
-        if k not in CONFIG_KEYS:
+        if k == 'motion':
+            # PROTOCOL.md 4: the tank moves; one mode of a beam clamped in a
+            # fixed frame cannot follow the frame's body forces
+            raise Fail('input', f"CONFIG motion={conf[k]}: the modal beam solid cannot apply a "
+                                "moving tank frame (the case's motion block)")
+        if k not in mp.CONFIG_KEYS:
             raise Fail('input', f"CONFIG key '{k}' unknown")
     try:
         with open(conf['case']) as f:

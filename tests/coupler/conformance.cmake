@@ -39,3 +39,12 @@ set_tests_properties(conformance_solid_mps conformance_solid_tlsph conformance_s
                      conformance_catches_bug_silent conformance_catches_bug_role
                      conformance_catches_bug_repeat conformance_catches_bug_norestore
                      PROPERTIES TIMEOUT 60 LABELS integration ENVIRONMENT OMP_NUM_THREADS=1)
+
+# A solid that says it honours a moving tank (accepts CONFIG motion) but
+# ignores it must be caught by the physical check.
+add_test(NAME conformance_catches_bug_motion
+         COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh "checks failed .*motion\\.honoured"
+                 ${CONFORMANCE} --solid "${CONFORMANCE_TOY} --bug motion"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(conformance_catches_bug_motion
+                     PROPERTIES TIMEOUT 60 LABELS integration ENVIRONMENT OMP_NUM_THREADS=1)

@@ -20,6 +20,9 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
   duplicate_id    LOADS naming one id twice                    /  spec names none), exit
                                                                   status to match (section 8)
   unknown_key     CONFIG with a key the solver cannot know: ERROR "input: ...", exit 2
+  motion          CONFIG motion=constant, the case's tank held tilted by 30 degrees with
+                  gravity on: the solid refuses (ERROR "input: ...", exit 2) or applies the
+                  tilted gravity (its free plate falls towards -x, section 4)
   timeout         CONFIG timeout_ms=1000, then silence: ERROR "timeout: ...", exit 1
   iteration_unasked  an ADVANCE repeating step 0 (iteration 1) without rollback=on in
                   CONFIG: ERROR "protocol: ...", exit 1
@@ -35,7 +38,8 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
 
 The case given with --case is copied with gravity set to zero (the common keys
 gravity.x/y) and any --set overrides applied; its path goes to the solver in
-CONFIG, as the coupler's case_resolved.yml does. Physical checks use only what
+CONFIG, as the coupler's case_resolved.yml does (the motion scenario's copy
+keeps gravity and holds the tank tilted). Physical checks use only what
 any elastic solid must do: unloaded and at rest it stays put, pushed +x it
 moves +x, and particles flagged `fixed` never move (section 5).
 
@@ -83,6 +87,11 @@ STATE_FRAMES = (('id', 4, 1), ('x', 8, 2), ('v', 8, 2), ('surface', 1, 1), ('fix
 NARRAYS = {0: 0, 1: 5, 2: 3}
 STATUS = ('input', 'io', 'memory', 'library', 'solver', 'diverged', 'protocol', 'timeout',
           'peer', 'interrupted')
+# the motion scenario: the tank held tilted by 30 degrees counterclockwise (a
+# constant tilt: no frame acceleration, the pivot does not matter), lab gravity on
+MOTION_G, MOTION_ANGLE = 9.81, 30.0
+MOTION_SETS = ['motion.kind=constant', f'motion.angle={MOTION_ANGLE}', 'motion.pivot.x=0.0',
+               'motion.pivot.y=0.0']
 EXIT_DEADLINE = 5.0     # s: a solver that has answered ERROR/BYE or got ABORT must be gone
 ABORT_DEADLINE = 3.0    # s: "well within the coupler's grace time" (5 s)
 
@@ -365,8 +374,11 @@ class Suite:
         self.current = None
         self.command = resolve_command(args.solid, args.build)
         self.case = os.path.join(self.tmp, 'case_resolved.yml')
+        self.case_motion = os.path.join(self.tmp, 'case_motion.yml')
         try:
             self.dp = write_case(args.case, args.set, self.case)
+            write_case(args.case, args.set + [f'gravity.y={-MOTION_G}'] + MOTION_SETS,
+                       self.case_motion)
         except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError) as e:
             shutil.rmtree(self.tmp, ignore_errors=True)
             sys.exit(f'conformance: case {args.case}: {type(e).__name__}: {e}')
@@ -376,8 +388,9 @@ class Suite:
 
     # -- conversation pieces, each reporting its own checks
 
-    def config_text(self, s, extra=''):
-        return f'case={self.case}\nout={s.out}\nprefix=solid\ntimeout_ms=60000\n' + extra
+    def config_text(self, s, extra='', case=None):
+        return (f'case={case or self.case}\nout={s.out}\nprefix=solid\ntimeout_ms=60000\n' +
+                extra)
 
     def hello(self, s):
         """Starts the solver and reads its HELLO; returns the HELLO text."""
@@ -769,6 +782,53 @@ class Suite:
                           text=self.config_text(s, 'conformance_no_such_key=1\n')))
         self.expect_error(s, 'config.unknown_key', 'input', 2)
 
+    def scenario_motion(self, s):
+        """A moving tank (section 4): READY and the tilted gravity applied, or a refusal."""
+        self.hello(s)
+        s.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s, 'motion=constant\n',
+                                                                case=self.case_motion)))
+        frames, _ = s.recv(self.args.ready_timeout)
+        bad = ['no answer to CONFIG'] if frames is None else wire_problems(frames)
+        f = fields(frames) if not bad else {}
+        if f and f['type'] == 9:
+            text = frames[-1].decode('utf-8', 'replace') if f['flags'] & 1 else ''
+            rc = s.wait_exit(EXIT_DEADLINE)
+            ok = text.startswith('input: ') and rc == 2
+            self.check('motion.answer', ok, f'refused: {text[:100]!r}, exit status {rc}' +
+                       ('' if ok else ' (a refusal is ERROR "input: ..." and exit 2)'))
+            return
+        if f and (f['type'] != 4 or f['payload'] != 1):
+            bad.append(f'{name_of(f["type"])} instead of READY (STATE) or ERROR')
+        r = None
+        if not bad:
+            try:
+                r = mp.decode(frames)
+            except mp.ProtocolError as e:
+                bad.append(f'codec: {e}')
+        self.check('motion.answer', not bad, '; '.join(bad) or 'READY: it applies the motion')
+        if bad:
+            raise Stop
+        x0 = {int(i): r.x[k].copy() for k, i in enumerate(r.id)}
+        n_sub, steps, t, last = 20, 5, 0.0, r
+        for k in range(steps):  # each step from the latest stable step (it may shrink)
+            dt = n_sub * last.dt
+            _, last = self.advance(s, k, t, dt, n_sub, mp.Payload.NONE)
+            t += dt
+        free = (last.surface == 1) & (last.fixed == 0)
+        dx = np.array([last.x[k] - x0[i] for k, i in enumerate(last.id.tolist())
+                       if free[k] and i in x0])
+        mx = float(dx[:, 0].mean()) if len(dx) else float('nan')
+        # long before the plate's first period the free particles fall freely
+        # along the tilted gravity's x component, -g sin(30 deg)
+        fall = 0.5 * MOTION_G * math.sin(math.radians(MOTION_ANGLE)) * t * t
+        self.check('motion.honoured', mx < -0.25 * fall,
+                   f'after {t:.3g} s at a {MOTION_ANGLE:g} deg tilt: mean dx of the {len(dx)} free '
+                   f'surface particles {mx:.3e} m (free fall along the tilt: -{fall:.3e} m; '
+                   f'needs < -{0.25 * fall:.3e})')
+        s.send(mp.Message(mp.Type.STOP, step=steps, time=t))
+        s.recv(self.args.step_timeout)
+        s.wait_exit(EXIT_DEADLINE)
+
     def scenario_timeout(self, s):
         self.hello(s)
         s.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s).replace(
@@ -888,7 +948,7 @@ class Suite:
                    ('' if frames is None else '; a message got through'))
 
     SCENARIOS = ('run', 'abort', 'reject', 'bad_magic', 'truncated', 'wrong_version',
-                 'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'timeout',
+                 'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'motion', 'timeout',
                  'iteration_unasked', 'rollback', 'curve', 'curve_no_key')
 
     def run(self):

@@ -101,7 +101,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
         hang(s);
     struct mps_case *c = NULL;
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
-    const char *const ignore[] = {"fluid.", "coupling.", NULL};
+    /* motion: a moving case never reaches here (CONFIG motion is refused) */
+    const char *const ignore[] = {"fluid.", "coupling.", "motion.", NULL};
     enum mps_status st = mps_case_load(&c, case_path, NULL, 0, tables, 2, ignore, err);
     if (!st)
         st = solid_scene_read(&s->scene, c, err);
@@ -286,10 +287,12 @@ int main(int argc, char **argv)
     }
     if (s.hang_in && !strcmp(s.hang_in, "hello"))
         hang(&s);
+    /* a rigid plate fixed in the tank: it has no body forces to move
+     * (moving_frame 0) */
     static const struct proto_solver_ops ops = {"solid", "fake", configure, ready,
-                                                advance, finish,  save,      restore};
+                                                advance, finish,  save,      restore, 0};
     static const struct proto_solver_ops ops_fixed = {"solid", "fake", configure,
-                                                      ready,   advance, finish, NULL, NULL};
+                                                      ready,   advance, finish, NULL, NULL, 0};
     enum mps_status st = proto_solver_run(endpoint, rollback ? &ops : &ops_fixed, &s, hello_ms,
                                           &stop_flag, &stats, &err);
     if (st)

@@ -1,7 +1,7 @@
 /* libFuzzer target: the case-file reader (YAML, declared keys, --set) and
  * the checks across keys that the coupler runs before it launches anything
  * (fluid_params_read, solid_scene_read: blocks in the tank, bodies, the
- * memory estimate). Input layout: the YAML file, then optionally a NUL byte
+ * memory estimate; mps_motion_read: the tank's motion and its table). Input layout: the YAML file, then optionally a NUL byte
  * and --set items, one a line. The file is an in-memory file (memfd), read
  * through its /proc path as the programs read theirs. On success the
  * resolved YAML is written and must load again. */
@@ -16,6 +16,7 @@
 #include "coupler_keys.h"
 #include "fluid_params.h"
 #include "mps_case.h"
+#include "mps_motion.h"
 #include "solid_scene.h"
 
 #define MAX_SETS 16
@@ -64,10 +65,11 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         }
     }
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
-                                                 solid_case_keys, coupler_case_keys};
+                                                 solid_case_keys, coupler_case_keys,
+                                                 mps_motion_keys};
     struct mps_case *c = NULL;
     struct mps_err err;
-    if (mps_case_load(&c, path, sets, nsets, tables, 4, NULL, &err) == MPS_OK) {
+    if (mps_case_load(&c, path, sets, nsets, tables, 5, NULL, &err) == MPS_OK) {
         struct fluid_params fp;
         struct solid_scene *sc = malloc(sizeof *sc);
         if (mps_case_has(c, "fluid.tank.width"))
@@ -75,6 +77,12 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         if (mps_case_count(c, "solid.bodies") > 0)
             solid_scene_read(sc, c, &err);
         free(sc);
+        struct mps_motion *m = NULL;
+        if (mps_motion_read(&m, c, &err) == MPS_OK) {
+            struct mps_motion_frame f = mps_motion_at(m, 0.5 * mps_case_double(c, "end_time"));
+            (void)f;
+        }
+        mps_motion_destroy(&m);
         char *y = mps_case_resolved_yaml(c);
         if (!y)
             abort();
@@ -82,7 +90,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
         struct mps_case *again = NULL;
         if (write_file(fd, y, strlen(y)) != 0)
             abort();
-        if (mps_case_load(&again, path, NULL, 0, tables, 4, NULL, &err) != MPS_OK) {
+        if (mps_case_load(&again, path, NULL, 0, tables, 5, NULL, &err) != MPS_OK) {
             fprintf(stderr, "resolved case does not load again: %s\n%s\n", err.msg, y);
             abort();
         }

@@ -1,0 +1,45 @@
+# The rolling tank (issue 17, docs/sloshing.md) through the coupler.
+set(SLOSH_OUT ${CMAKE_BINARY_DIR}/test_out/sloshing)
+set(COUPLER ${CMAKE_BINARY_DIR}/bin/coupler)
+
+# A solid that cannot apply the tank's motion is refused (PROTOCOL.md 4,
+# CONFIG motion): the Python modal solid says so itself, the fake rigid solid
+# through the C solver loop; the coupler stops the run with exit status 2.
+add_test(NAME coupled_motion_refused_by_python_solid
+  COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_status.sh 2
+          "^coupler: input: solid solver: input: CONFIG motion=sinusoid: the modal beam solid cannot apply a moving tank frame"
+          ${COUPLER} cases/sloshing_low/case.yml --out ${SLOSH_OUT}/refused_py --quiet
+          --set dp=0.004 --solid "/usr/bin/python3 solid_solver/python/modal_beam_solid.py"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME coupled_motion_refused_by_fake_solid
+  COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_status.sh 2
+          "^coupler: input: solid solver: input: CONFIG motion=sinusoid: this solid solver \\(fake\\) cannot apply a moving tank frame"
+          ${COUPLER} cases/sloshing_low/case.yml --out ${SLOSH_OUT}/refused_fake --quiet
+          --set dp=0.004 --solid fake_solid
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# The measured roll table ends at 4.986 s: a run past it is refused before
+# anything is launched, naming the key and its line.
+add_test(NAME coupled_motion_table_too_short
+  COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh
+          "^coupler: cases/sloshing_high/case.yml:[0-9]+: motion.table.file = roll_deep_deg.csv: the table ends at t = 4.9863 s, before end_time = 10 s$"
+          ${COUPLER} cases/sloshing_high/case.yml --out ${SLOSH_OUT}/table_short --quiet
+          --set motion.kind=table
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupled_motion_refused_by_python_solid coupled_motion_refused_by_fake_solid
+  coupled_motion_table_too_short PROPERTIES LABELS integration TIMEOUT 60)
+
+# Both cases at 2 mm (the plate 2 particles thick) to 2 s with the MPS solid:
+# stable (nothing lost, no tank guard use, the plate bounded), the motion the
+# declared one in both solvers (Eq. 55's period), the plate in the right phase
+# (tests/coupler/sloshing_check.py). At 2 mm the tank is 0.610 m wide (a whole
+# number of spacings: with 0.609 a particle creeps through the right floor
+# corner) and the fluid step is the CFL one, at which the coupling holds at
+# this spacing (docs/sloshing.md). Measured lags of the plate behind the
+# tilt's push: 14 (low) and 51 degrees (high); the band -30..120 takes any
+# damped response short of a mirrored one.
+foreach(fill low high)
+  add_test(NAME coupled_sloshing_${fill}_coarse
+    COMMAND sh -c "${COUPLER} cases/sloshing_${fill}/case.yml --out ${SLOSH_OUT}/${fill}_2mm --quiet --set dp=0.002 --set end_time=2.0 --set output.interval=0 --set fluid.tank.width=0.610 --set fluid.blocks.1.x1=0.610 --set motion.pivot.x=0.305 --set fluid.dt_max=1e-3 && /usr/bin/python3 tests/coupler/sloshing_check.py ${SLOSH_OUT}/${fill}_2mm --lag-band -30 120"
+    WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(coupled_sloshing_${fill}_coarse PROPERTIES TIMEOUT 600 LABELS validation)
+endforeach()
