@@ -24,6 +24,7 @@
 #include <string.h>
 
 #include "mps_case.h"
+#include "mps_motion.h"
 #include "mps_timer.h"
 #include "solid_model.h"
 #include "solid_scene.h"
@@ -76,9 +77,10 @@ int main(int argc, char **argv)
 
     struct mps_err err = {0};
     struct mps_case *cs = NULL;
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys};
+    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
+                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
-    if (mps_case_load(&cs, case_path, sets, nsets, tables, 2, ignore, &err))
+    if (mps_case_load(&cs, case_path, sets, nsets, tables, 3, ignore, &err))
         return fprintf(stderr, "solid_static_load: %s\n", err.msg), 2;
     struct solid_scene *sc = malloc(sizeof *sc);
     const struct solid_model_ops *ops =
