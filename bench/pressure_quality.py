@@ -356,8 +356,11 @@ def section_still(a, builds):
             p = probes(out)
             t, ms = p['time'], p['max_speed']
             bp = p['bottom_pressure'][t > 0.5]
+            # a run that diverges stops early: its later seconds are '-'
             print('| %s | %s | %s | %.2f |' % (
-                name, tag, ' '.join('%.2g' % ms[(t > s) & (t <= s + 1)].max() for s in range(10)), bp.std()))
+                name, tag, ' '.join('%.2g' % ms[(t > s) & (t <= s + 1)].max()
+                                    if ((t > s) & (t <= s + 1)).any() else '-' for s in range(10)),
+                bp.std()))
 
 
 def section_shifting(a, b):

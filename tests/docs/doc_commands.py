@@ -117,6 +117,8 @@ SHORT = [
     ('docs/pressure.md', r'^/usr/bin/python3 bench/pressure_quality\.py .*$',
      '/usr/bin/python3 bench/pressure_quality.py --only impact --dps 0.008 --out /tmp/pq_short',
      'the impact section at 8 mm only (the whole page: 40 minutes and a second build)'),
+    ('docs/pressure.md', r'^bench/pressure_quality\.py --only still$', 'true',
+     'the still-water variants: eleven 10 s runs, about 10 minutes'),
     ('docs/security.md', r'^(build/fuzz/fuzz_\w+) -runs=\d+ ', r'test ! -x \g<1> || \g<1> -runs=5000 ',
      'each fuzzer for 5000 inputs (millions: 15 minutes); skipped where the build has no '
      'fuzzers (MPS_FUZZ=1 and clang)'),
