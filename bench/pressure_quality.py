@@ -44,6 +44,9 @@ sys.path.insert(0, HERE)
 import dambreak_compare as dc  # noqa: E402
 import plate_compare as pc  # noqa: E402
 
+sys.path.insert(0, os.path.join(ROOT, 'tests', 'fluid'))
+import check_flicker  # noqa: E402
+
 RHO, G = 1000.0, 9.81
 
 
@@ -94,18 +97,9 @@ def probes(run_dir):
 
 
 def snapshot_shares(run_dir, after=0.05):
-    """(time, share of interior fluid at P = 0) per fluid snapshot."""
-    out = []
-    for fn in sorted(glob.glob(os.path.join(run_dir, 'fluid_*.h5'))):
-        with h5py.File(fn, 'r') as f:
-            t = float(f.attrs['time'])
-            ptype = f['particles/type'][:]
-            p = f['particles/pressure'][:]
-            surf = f['particles/free_surface'][:]
-        interior = (ptype == 0) & (surf == 0)
-        if interior.any():
-            out.append((t, float(np.mean(p[interior] == 0.0))))
-    return [s for s in out if s[0] > after]
+    """(time, share of interior fluid at P = 0) per fluid snapshot after
+    `after`: the measure of ctest fluid_pressure_flicker, one definition."""
+    return check_flicker.shares(run_dir, after)
 
 
 def step_shares(run_dir, after=0.05):
