@@ -14,6 +14,11 @@ const struct mps_key_spec mps_case_common_keys[] = {
      "time between HDF5 snapshots (0: no snapshots)"},
     {"output.probe_interval", MPS_KEY_DOUBLE, "0.001", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI,
      NULL, "s", "time between probes.csv rows"},
+    /* simulated time, not wall time: a run then checkpoints at the same
+     * steps whatever the machine's load (docs/restart.md: the default, its
+     * cost and the wall time it bounds) */
+    {"output.checkpoint_interval", MPS_KEY_DOUBLE, "0.1", 0, 0, MPS_KEY_NO_HI, NULL, "s",
+     "time between checkpoints, from which a run restarts (0: none; docs/restart.md)"},
     {"description", MPS_KEY_STRING, "", 0, 0, 0, NULL, "", "free text"},
     /* read by the coupler only, declared here so every program accepts them */
     {"solid_solver", MPS_KEY_STRING, "solid_solver", 0, 0, 0, NULL, "",

@@ -3,6 +3,7 @@
 #include "mps_cli.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -19,6 +20,9 @@ static void print_help(const char *usage, const struct mps_cli_extra *extra, int
            "  --out DIR            output directory (required; created if missing)\n"
            "  --set KEY=VALUE      override a case-file key; repeatable\n"
            "  --quiet              no progress output\n"
+           "  --restart DIR        continue the run in DIR from its latest checkpoint\n"
+           "  --from TIME          with --restart: from the checkpoint nearest to TIME\n"
+           "  --stop-at TIME       stop at the first checkpoint at or after TIME (s)\n"
            "  --version            show the version and git revision it was built from\n"
            "  --help               show this help\n");
     for (int k = 0; k < nextra; k++) {
@@ -62,6 +66,8 @@ enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
                               struct mps_err *err)
 {
     memset(cli, 0, sizeof *cli);
+    cli->restart_from = -1.0;
+    cli->stop_at = INFINITY;
     if (!extra)
         nextra = 0;
     for (int k = 0; k < nextra; k++)
@@ -120,6 +126,21 @@ enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
             cli->quiet = 1;
             continue;
         }
+        if (match(a, "--restart", &v)) {
+            if (!(cli->restart_dir = option_value(v, argc, argv, &i)))
+                return mps_err_set(err, MPS_EINPUT, "--restart needs the run's directory");
+            continue;
+        }
+        if (match(a, "--from", &v) || match(a, "--stop-at", &v)) {
+            const char *t = option_value(v, argc, argv, &i);
+            char *end = NULL;
+            double val = t ? strtod(t, &end) : NAN;
+            if (!t || end == t || *end || !(val >= 0.0) || !isfinite(val))
+                return mps_err_set(err, MPS_EINPUT, "%s needs a time >= 0 in seconds, got '%s'",
+                                   a[2] == 'f' ? "--from" : "--stop-at", t ? t : "");
+            *(a[2] == 'f' ? &cli->restart_from : &cli->stop_at) = val;
+            continue;
+        }
         int k;
         for (k = 0; k < nextra; k++)
             if (match(a, extra[k].name, &v))
@@ -138,6 +159,24 @@ enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
             return mps_err_set(err, MPS_EINPUT, "%s needs a value", extra[k].name);
         extra[k].value = val;
     }
+    if (cli->restart_dir) {
+        if (cli->case_path)
+            return mps_err_set(err, MPS_EINPUT, "--restart %s takes no case file ('%s'): the "
+                               "run continues with the case its checkpoint holds",
+                               cli->restart_dir, cli->case_path);
+        if (cli->out_dir)
+            return mps_err_set(err, MPS_EINPUT, "--restart %s writes into that directory: "
+                               "no --out", cli->restart_dir);
+        for (int k = 0; k < cli->nsets; k++)
+            if (strncmp(cli->sets[k], "end_time=", 9) != 0)
+                return mps_err_set(err, MPS_EINPUT, "--set %s: a restart takes only "
+                                   "--set end_time=T (the rest is the checkpoint's case)",
+                                   cli->sets[k]);
+        cli->out_dir = cli->restart_dir;
+        return mps_simd_check_env(err);
+    }
+    if (cli->restart_from >= 0.0)
+        return mps_err_set(err, MPS_EINPUT, "--from needs --restart DIR");
     if (!cli->case_path)
         return mps_err_set(err, MPS_EINPUT, "missing case file (see --help)");
     return mps_simd_check_env(err);

@@ -1,5 +1,9 @@
 /* The command line every program shares:
- *   PROGRAM CASE.yml --out DIR [--set key=value]... [--quiet] [extra options]
+ *   PROGRAM CASE.yml --out DIR [--set key=value]... [--quiet] [--stop-at T] [extra options]
+ *   PROGRAM --restart DIR [--from T] [--set end_time=T] [--quiet] [--stop-at T]
+ * The second continues the run in DIR from its latest checkpoint, or the
+ * one nearest to --from T (docs/restart.md). --stop-at T stops a run at
+ * its first checkpoint at or after simulated time T, as if killed there.
  * Extra options are declared by the program as name + whether they take a
  * value; anything else is an error naming the option. */
 #ifndef MPS_CLI_H
@@ -25,6 +29,9 @@ struct mps_cli {
     const char *sets[MPS_CLI_MAX_SETS];
     int nsets;
     int quiet;
+    const char *restart_dir;      /* --restart DIR (then out_dir = DIR, no case_path) */
+    double restart_from;          /* --from T, or -1: the latest checkpoint */
+    double stop_at;               /* --stop-at T, or INFINITY */
 };
 
 /* Parses argv. extra (may be NULL) is an array of nextra options, filled in

@@ -530,6 +530,20 @@ static enum mps_status check_fields(size_t n, const double (*x)[MPS_DIM],
     return MPS_OK;
 }
 
+/* Room for one more snapshot in the index. */
+static enum mps_status grow_index(struct mps_h5_series *s, struct mps_err *err)
+{
+    if (s->count < s->cap)
+        return MPS_OK;
+    int cap = s->cap ? 2 * s->cap : 64;
+    char **g = realloc(s->grids, (size_t)cap * sizeof *g);
+    if (!g)
+        return mps_err_set(err, MPS_ENOMEM, "snapshot series '%s': out of memory", s->prefix);
+    s->grids = g;
+    s->cap = cap;
+    return MPS_OK;
+}
+
 enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, size_t n,
                              const double (*x)[MPS_DIM], const struct mps_field *fields,
                              int nfields, struct mps_err *err)
@@ -540,14 +554,8 @@ enum mps_status mps_h5_write(struct mps_h5_series *s, double time, long step, si
     enum mps_status st = check_fields(n, x, fields, nfields, err);
     if (st != MPS_OK)
         return st;
-    if (s->count == s->cap) {
-        int cap = s->cap ? 2 * s->cap : 64;
-        char **g = realloc(s->grids, (size_t)cap * sizeof *g);
-        if (!g)
-            return mps_err_set(err, MPS_ENOMEM, "snapshot series '%s': out of memory", s->prefix);
-        s->grids = g;
-        s->cap = cap;
-    }
+    if ((st = grow_index(s, err)))
+        return st;
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 
     /* PREFIX_NNNNNN: NNNNNN counts snapshots (not steps), so names sort and
@@ -635,6 +643,48 @@ enum mps_status mps_h5_rewind(struct mps_h5_series *s, int count, struct mps_err
         count = 0;
     while (s->count > count)
         free(s->grids[--s->count]);
+    return write_index(s, err);
+}
+
+enum mps_status mps_h5_put(const struct mps_h5_series *s, struct mps_ckpt *c,
+                           struct mps_err *err)
+{
+    size_t len = 0;
+    for (int k = 0; s && k < s->count; k++)
+        len += strlen(s->grids[k]) + 1;
+    char *all = malloc(len + 1);
+    if (!all)
+        return mps_err_set(err, MPS_ENOMEM, "checkpoint: no memory for the XDMF index");
+    size_t at = 0;
+    for (int k = 0; s && k < s->count; k++) {
+        size_t l = strlen(s->grids[k]) + 1;
+        memcpy(all + at, s->grids[k], l);
+        at += l;
+    }
+    enum mps_status st = mps_ckpt_put(c, "snapshots", all, len, err);
+    free(all);
+    return st;
+}
+
+enum mps_status mps_h5_get(struct mps_h5_series *s, struct mps_ckpt *c, struct mps_err *err)
+{
+    const void *data;
+    size_t len;
+    enum mps_status st = mps_ckpt_get_any(c, "snapshots", &data, &len, err);
+    if (st || !s)
+        return st;
+    const char *p = data, *end = p + len;
+    if (len && end[-1] != '\0')
+        return mps_err_set(err, MPS_EINPUT, "checkpoint: the XDMF index is damaged");
+    mps_h5_rewind(s, 0, NULL);
+    while (p < end) {
+        if ((st = grow_index(s, err)))
+            return st;
+        if (!(s->grids[s->count] = dup_str(p)))
+            return mps_err_set(err, MPS_ENOMEM, "checkpoint: no memory for the XDMF index");
+        s->count++;
+        p += strlen(p) + 1;
+    }
     return write_index(s, err);
 }
 

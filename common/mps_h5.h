@@ -18,6 +18,7 @@
 
 #include <stddef.h>
 
+#include "mps_ckpt.h"
 #include "mps_dim.h"
 #include "mps_err.h"
 
@@ -58,6 +59,15 @@ int mps_h5_count(const struct mps_h5_series *s);
  * without them and the next write reuses their names, overwriting the files.
  * count >= the current count does nothing. NULL ok. */
 enum mps_status mps_h5_rewind(struct mps_h5_series *s, int count, struct mps_err *err);
+
+/* The series' index (the XDMF block of each snapshot so far) as a block of a
+ * state image (mps_ckpt.h), and back: a run restarted from a checkpoint
+ * continues the series where the checkpoint was taken, its next snapshot
+ * overwriting the first one written after it (get rewrites the XDMF).
+ * s may be NULL (no snapshots): an empty block. */
+enum mps_status mps_h5_put(const struct mps_h5_series *s, struct mps_ckpt *c,
+                           struct mps_err *err);
+enum mps_status mps_h5_get(struct mps_h5_series *s, struct mps_ckpt *c, struct mps_err *err);
 
 /* Closes the series (XDMF is already complete); accepts NULL, sets *s NULL. */
 void mps_h5_close(struct mps_h5_series **s);

@@ -2,6 +2,7 @@
 
 #include <math.h>
 #include <omp.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -635,6 +636,62 @@ enum mps_status mps_nbr_list_copy(struct mps_nbr_list *dst, const struct mps_nbr
             memcpy(dst->r2, src->r2, npairs * sizeof *dst->r2);
     }
     return MPS_OK;
+}
+
+enum mps_status mps_nbr_list_put(const struct mps_nbr_list *l, const char *name,
+                                 struct mps_ckpt *c, struct mps_err *err)
+{
+    char key[96];
+    const size_t n = l->n, npairs = l->start ? l->start[n] : 0;
+    double head[2] = {(double)n, l->radius}; /* n < 2^53 */
+    int r2 = !l->no_r2 && l->r2;
+    enum mps_status st;
+    snprintf(key, sizeof key, "%s.list", name);
+    if ((st = mps_ckpt_put(c, key, head, sizeof head, err)))
+        return st;
+    snprintf(key, sizeof key, "%s.start", name);
+    if (l->start && (st = mps_ckpt_put(c, key, l->start, (n + 1) * sizeof *l->start, err)))
+        return st;
+    if (!l->start && (st = mps_ckpt_put(c, key, NULL, 0, err)))
+        return st;
+    snprintf(key, sizeof key, "%s.j", name);
+    if ((st = mps_ckpt_put(c, key, l->j, npairs * sizeof *l->j, err)))
+        return st;
+    snprintf(key, sizeof key, "%s.r2", name);
+    return mps_ckpt_put(c, key, r2 ? l->r2 : NULL, r2 ? npairs * sizeof *l->r2 : 0, err);
+}
+
+enum mps_status mps_nbr_list_get(struct mps_nbr_list *l, const char *name, struct mps_ckpt *c,
+                                 struct mps_err *err)
+{
+    char key[96];
+    double head[2];
+    const void *start, *j, *r2;
+    size_t bs, bj, br;
+    enum mps_status st;
+    snprintf(key, sizeof key, "%s.list", name);
+    if ((st = mps_ckpt_get(c, key, head, sizeof head, err)))
+        return st;
+    snprintf(key, sizeof key, "%s.start", name);
+    if ((st = mps_ckpt_get_any(c, key, &start, &bs, err)))
+        return st;
+    snprintf(key, sizeof key, "%s.j", name);
+    if ((st = mps_ckpt_get_any(c, key, &j, &bj, err)))
+        return st;
+    snprintf(key, sizeof key, "%s.r2", name);
+    if ((st = mps_ckpt_get_any(c, key, &r2, &br, err)))
+        return st;
+    /* the image's arrays as a list, copied by the one copy there is */
+    size_t n = (size_t)head[0];
+    struct mps_nbr_list view = {.n = n, .start = bs ? (size_t *)start : NULL, .j = (int *)j,
+                                .r2 = br ? (double *)r2 : NULL, .no_r2 = !br,
+                                .radius = head[1]};
+    size_t npairs = bs ? view.start[n] : 0;
+    if ((bs && bs != (n + 1) * sizeof(size_t)) || bj != npairs * sizeof(int) ||
+        (br && br != npairs * sizeof(double)))
+        return mps_err_set(err, MPS_EINPUT, "checkpoint: neighbour list '%s' is inconsistent",
+                           name);
+    return mps_nbr_list_copy(l, &view, err);
 }
 
 enum mps_status mps_nbr_grid_cell_order(struct mps_nbr_grid *g, size_t m, size_t *perm,

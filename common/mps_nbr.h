@@ -10,6 +10,7 @@
 
 #include <stddef.h>
 
+#include "mps_ckpt.h"
 #include "mps_dim.h"
 #include "mps_mem.h"
 #include "mps_err.h"
@@ -89,6 +90,14 @@ void mps_nbr_list_free(struct mps_nbr_list *l);
  * solver's checkpoint of a list it would otherwise rebuild differently. */
 enum mps_status mps_nbr_list_copy(struct mps_nbr_list *dst, const struct mps_nbr_list *src,
                                   struct mps_err *err);
+
+/* The list as blocks of a state image (mps_ckpt.h; name prefixes the block
+ * names), and back into l (grown as needed): a solver's checkpoint of a list
+ * it would otherwise rebuild differently. */
+enum mps_status mps_nbr_list_put(const struct mps_nbr_list *l, const char *name,
+                                 struct mps_ckpt *c, struct mps_err *err);
+enum mps_status mps_nbr_list_get(struct mps_nbr_list *l, const char *name, struct mps_ckpt *c,
+                                 struct mps_err *err);
 
 /* The pairs of src that are closer than radius at positions x (which may have
  * moved since src was built: r2 is recomputed), kept in src's order. Used to

@@ -1,6 +1,7 @@
 #include "mps_particles.h"
 
 #include <omp.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -134,50 +135,24 @@ void mps_particles_free(struct mps_particles *ps)
     ps->n = ps->cap = 0;
 }
 
-enum mps_status mps_particles_save(const struct mps_particles *ps,
-                                   struct mps_particles_ckpt *ck, struct mps_err *err)
+enum mps_status mps_particles_put(const struct mps_particles *ps, struct mps_ckpt *c,
+                                  struct mps_err *err)
 {
-    if (ck->nfields && ck->nfields != ps->nfields)
-        return mps_err_set(err, MPS_EINPUT, "particles: checkpoint of %d fields, table has %d",
-                           ck->nfields, ps->nfields);
-    if (ps->n > ck->cap || !ck->nfields) {
-        size_t cap = ps->n + ps->n / 8 + 16; /* room for a few more before regrowing */
-        for (int k = 0; k < ps->nfields; k++) {
-            void *p = realloc(ck->data[k], cap * field_bytes(&ps->f[k]));
-            if (!p)
-                return mps_err_set(err, MPS_ENOMEM,
-                                   "particles: no memory to checkpoint field %s (%zu)",
-                                   ps->f[k].name, cap);
-            ck->data[k] = p;
-        }
-        ck->cap = cap;
-        ck->nfields = ps->nfields;
-    }
-    for (int k = 0; k < ps->nfields; k++)
-        if (ps->n)
-            memcpy(ck->data[k], *ps->f[k].data, ps->n * field_bytes(&ps->f[k]));
-    ck->n = ps->n;
-    return MPS_OK;
+    uint64_t n = ps->n;
+    enum mps_status st = mps_ckpt_put(c, "particles", &n, sizeof n, err);
+    for (int k = 0; k < ps->nfields && !st; k++)
+        st = mps_ckpt_put(c, ps->f[k].name, *ps->f[k].data, ps->n * field_bytes(&ps->f[k]), err);
+    return st;
 }
 
-enum mps_status mps_particles_restore(struct mps_particles *ps,
-                                      const struct mps_particles_ckpt *ck, struct mps_err *err)
+enum mps_status mps_particles_get(struct mps_particles *ps, struct mps_ckpt *c,
+                                  struct mps_err *err)
 {
-    if (ck->nfields != ps->nfields)
-        return mps_err_set(err, MPS_EINPUT, "particles: checkpoint of %d fields, table has %d",
-                           ck->nfields, ps->nfields);
-    enum mps_status st = mps_particles_resize(ps, ck->n, err);
-    if (st)
+    uint64_t n;
+    enum mps_status st = mps_ckpt_get(c, "particles", &n, sizeof n, err);
+    if (st || (st = mps_particles_resize(ps, (size_t)n, err)))
         return st;
-    for (int k = 0; k < ps->nfields; k++)
-        if (ck->n)
-            memcpy(*ps->f[k].data, ck->data[k], ck->n * field_bytes(&ps->f[k]));
-    return MPS_OK;
-}
-
-void mps_particles_ckpt_free(struct mps_particles_ckpt *ck)
-{
-    for (int k = 0; k < MPS_PARTICLES_MAX_FIELDS; k++)
-        free(ck->data[k]);
-    memset(ck, 0, sizeof *ck);
+    for (int k = 0; k < ps->nfields && !st; k++)
+        st = mps_ckpt_get(c, ps->f[k].name, *ps->f[k].data, ps->n * field_bytes(&ps->f[k]), err);
+    return st;
 }

@@ -7,6 +7,7 @@
 
 #include <stddef.h>
 
+#include "mps_ckpt.h"
 #include "mps_err.h"
 #include "mps_h5.h"
 
@@ -47,23 +48,15 @@ int mps_particles_output(const struct mps_particles *ps, struct mps_field *out, 
 /* Frees every array and sets the solver's pointers NULL. */
 void mps_particles_free(struct mps_particles *ps);
 
-/* A copy of every registered field of the particles, for a solver that must
- * return to an earlier state (implicit coupling repeats a step from its
- * start). Zero-initialise; it owns its arrays. */
-struct mps_particles_ckpt {
-    size_t n, cap;      /* particles held, room per field */
-    int nfields;
-    void *data[MPS_PARTICLES_MAX_FIELDS];
-};
-
-/* Copies the n particles of every field into ck (growing it as needed). */
-enum mps_status mps_particles_save(const struct mps_particles *ps,
-                                   struct mps_particles_ckpt *ck, struct mps_err *err);
-/* Resizes ps to ck's count and copies every field back: the particles are
- * then bit for bit what they were at the save. ck must come from a save of
- * the same field table. */
-enum mps_status mps_particles_restore(struct mps_particles *ps,
-                                      const struct mps_particles_ckpt *ck, struct mps_err *err);
-void mps_particles_ckpt_free(struct mps_particles_ckpt *ck);
+/* Every registered field of the n particles as blocks of a state image
+ * (mps_ckpt.h: implicit coupling's rollback and the checkpoint files), one
+ * block per field named by it, after a block with n. */
+enum mps_status mps_particles_put(const struct mps_particles *ps, struct mps_ckpt *c,
+                                  struct mps_err *err);
+/* Resizes ps to the image's count and reads every field back: the particles
+ * are then bit for bit what they were at the put. The image must come from
+ * the same field table (names and sizes are checked). */
+enum mps_status mps_particles_get(struct mps_particles *ps, struct mps_ckpt *c,
+                                  struct mps_err *err);
 
 #endif

@@ -4,6 +4,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 struct mps_probes {
     FILE *f;
@@ -38,12 +40,11 @@ static enum mps_status flush_row(struct mps_probes *p, struct mps_err *err)
     return MPS_OK;
 }
 
-enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const char *comment,
-                                const char *const *names, int n, struct mps_err *err)
+/* A probes file object for path with n columns (no file yet). */
+static enum mps_status alloc_probes(struct mps_probes **out, const char *path, int n,
+                                    struct mps_err *err)
 {
     *out = NULL;
-    if (n < 0 || (n > 0 && !names))
-        return mps_err_set(err, MPS_EINPUT, "%s: bad probe list (%d probes)", path, n);
     struct mps_probes *p = calloc(1, sizeof *p);
     size_t len = strlen(path) + 1;
     if (!p || !(p->path = malloc(len))) {
@@ -52,9 +53,22 @@ enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const
     }
     memcpy(p->path, path, len);
     p->n = n;
+    *out = p;
+    return MPS_OK;
+}
+
+enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const char *comment,
+                                const char *const *names, int n, struct mps_err *err)
+{
+    *out = NULL;
+    if (n < 0 || (n > 0 && !names))
+        return mps_err_set(err, MPS_EINPUT, "%s: bad probe list (%d probes)", path, n);
+    struct mps_probes *p;
+    enum mps_status st = alloc_probes(&p, path, n, err);
+    if (st)
+        return st;
     if (!(p->f = fopen(path, "w"))) {
-        enum mps_status st =
-            mps_err_set(err, MPS_EIO, "cannot create '%s': %s", path, strerror(errno));
+        st = mps_err_set(err, MPS_EIO, "cannot create '%s': %s", path, strerror(errno));
         mps_probes_close(&p);
         return st;
     }
@@ -66,8 +80,38 @@ enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const
         csv_cell(p->f, names[k] ? names[k] : "");
     }
     fputc('\n', p->f);
-    enum mps_status st = flush_row(p, err);
+    st = flush_row(p, err);
     if (st != MPS_OK) {
+        mps_probes_close(&p);
+        return st;
+    }
+    *out = p;
+    return MPS_OK;
+}
+
+long mps_probes_bytes(const struct mps_probes *p)
+{
+    return p ? ftell(p->f) : 0;
+}
+
+enum mps_status mps_probes_resume(struct mps_probes **out, const char *path, long bytes, int n,
+                                  struct mps_err *err)
+{
+    struct mps_probes *p;
+    enum mps_status st = alloc_probes(out, path, n, err);
+    if (st)
+        return st;
+    p = *out;
+    *out = NULL;
+    struct stat sb;
+    if (stat(path, &sb) != 0 || sb.st_size < bytes)
+        st = mps_err_set(err, MPS_EINPUT, "%s: %s than the checkpoint's %ld bytes: not the file "
+                         "the checkpoint was written with", path,
+                         stat(path, &sb) != 0 ? "missing, shorter" : "shorter", bytes);
+    else if (truncate(path, bytes) != 0 || !(p->f = fopen(path, "a")) ||
+             fseek(p->f, 0, SEEK_END) != 0)
+        st = mps_err_set(err, MPS_EIO, "cannot continue '%s': %s", path, strerror(errno));
+    if (st) {
         mps_probes_close(&p);
         return st;
     }

@@ -16,6 +16,12 @@ enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const
 /* One row: time then n values (%.9g). */
 enum mps_status mps_probes_write(struct mps_probes *p, double time, const double *values,
                                  struct mps_err *err);
+/* Bytes written so far (header included): where a restart continues. */
+long mps_probes_bytes(const struct mps_probes *p);
+/* Continues path as written by a run up to its first bytes (mps_probes_bytes
+ * at a checkpoint): the rows after them are cut, the next row follows. */
+enum mps_status mps_probes_resume(struct mps_probes **out, const char *path, long bytes, int n,
+                                  struct mps_err *err);
 void mps_probes_close(struct mps_probes **p);
 
 #endif

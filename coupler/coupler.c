@@ -16,6 +16,7 @@
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -39,6 +40,7 @@
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_prov.h"
+#include "mps_restart.h"
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_link.h"
@@ -70,6 +72,7 @@ struct peer {
     double repeat_seconds;     /* the part of it in repeated iterations (implicit) */
     long exchanges;
     int can_rollback;          /* HELLO declared caps=rollback */
+    int can_checkpoint;        /* HELLO declared caps=checkpoint */
     char *bye;                 /* its summary JSON */
     char model[64];            /* as its HELLO announced it */
 };
@@ -116,6 +119,22 @@ struct coupler {
     double change_max;         /* largest converged rms change / step's displacement */
     long iter_probe_sum, iter_probe_steps; /* for the probe column */
     FILE *iter_log;            /* coupling.implicit.log: OUT/iterations.csv */
+    /* checkpoints (docs/restart.md): every solver writes its own, with the
+     * same number, in the ADVANCE asking for it; the coupler writes its
+     * part after their RESULTs, so a coupler checkpoint N implies theirs */
+    double ck_interval;        /* 0: none */
+    int ck_asked;              /* the user's case or --set gives the interval */
+    const char *ck_note;       /* why checkpoints are off although the default asks */
+    struct mps_ckpt disk;
+    struct mps_run_mark mark;
+    char *case_yaml;           /* the resolved case the checkpoints carry */
+    long restart;              /* --restart: the checkpoint number continued, else 0 */
+    char restart_path[4400];
+    double restart_time;
+    double stop_at;            /* --stop-at */
+    double stopped_at;         /* -1: not stopped */
+    long checkpoints;
+    double t_checkpoint;
 };
 
 static volatile int interrupted = 0;
@@ -350,10 +369,12 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     }
     /* PROTOCOL.md 4: caps=a,b,... (absent: none) */
     char caps[256];
-    p->can_rollback = 0;
+    p->can_rollback = p->can_checkpoint = 0;
     if (proto_text_get(m.text, ' ', "caps", caps, sizeof caps) == 1)
-        for (char *tok = strtok(caps, ","); tok; tok = strtok(NULL, ","))
+        for (char *tok = strtok(caps, ","); tok; tok = strtok(NULL, ",")) {
             p->can_rollback |= strcmp(tok, "rollback") == 0;
+            p->can_checkpoint |= strcmp(tok, "checkpoint") == 0;
+        }
     char model[64] = "";
     proto_text_get(m.text, ' ', "model", model, sizeof model);
     snprintf(p->model, sizeof p->model, "%s", model);
@@ -371,6 +392,32 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
         snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
         return mps_err_set(err, MPS_EINPUT, "%s", reason);
     }
+    /* PROTOCOL.md 4, 6: a restart or checkpoints the case asks for need the
+     * solver to write and read its state; the default interval is dropped
+     * with a note instead (a solver without the capability still runs) */
+    if (!p->can_checkpoint && (c->restart || (c->ck_interval > 0.0 && c->ck_asked))) {
+        char reason[512];
+        snprintf(reason, sizeof reason,
+                 "%s, and this %s solver cannot checkpoint (its HELLO declares no "
+                 "caps=checkpoint): %s (PROTOCOL.md 4, 6)",
+                 c->restart ? "the run restarts from a checkpoint"
+                            : "the case asks for checkpoints (output.checkpoint_interval)",
+                 p->name,
+                 c->restart ? "it cannot restart this run" : "set output.checkpoint_interval: 0");
+        struct proto_msg r = proto_msg_make(PROTO_REJECT);
+        r.text = reason;
+        proto_link_send(p->sock, &r, err);
+        snprintf(c->failed_peer, sizeof c->failed_peer, "%s", p->name);
+        return mps_err_set(err, MPS_EINPUT, "%s", reason);
+    }
+    if (!p->can_checkpoint && c->ck_interval > 0.0) {
+        c->ck_interval = 0.0;
+        c->ck_note = p->name[0] == 'f' ? "off: the fluid solver cannot checkpoint"
+                                       : "off: the solid solver cannot checkpoint";
+        if (!c->quiet)
+            fprintf(stderr, "coupler: note: no checkpoints: the %s solver (%s) declares no "
+                            "caps=checkpoint\n", p->name, model);
+    }
     /* the file this solver is about to read records its own run */
     enum mps_status rst = coupler_record_hello(
         &c->rec, &c->cs, c->tables, NTABLES, k,
@@ -381,6 +428,8 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     snprintf(cfg, sizeof cfg, "case=%s\nout=%s\nprefix=%s\ntimeout_ms=%.0f\n%s", resolved_case,
              c->out, p->name, 1000.0 * (2.0 * c->step_timeout + 60.0),
              c->implicit ? "rollback=on\n" : "");
+    if (c->restart) /* PROTOCOL.md 4: start from checkpoint N */
+        snprintf(cfg + strlen(cfg), sizeof cfg - strlen(cfg), "restart=%ld\n", c->restart);
     /* PROTOCOL.md 4: a solver that cannot apply the tank's motion refuses the
      * key instead of running a fixed tank */
     if (mps_motion_moving(c->motion))
@@ -505,6 +554,8 @@ static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
         names[n++] = "coupling_iterations";
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", c->out);
+    if (c->restart)
+        return mps_probes_resume(&c->probes, path, c->mark.table_bytes[0], n, err);
     char *comment = mps_prov_comment(c->cs, "coupler");
     enum mps_status st = mps_probes_open(&c->probes, path, comment, names, n, err);
     free(comment);
@@ -652,6 +703,62 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
     return MPS_OK;
 }
 
+/* What the coupler holds between steps, besides the solid's interface (the
+ * restored solid reports it again in READY) and the fluid's loads (sent
+ * again by the fluid in the next step before the solid uses them): the
+ * clock, the solvers' last stable steps (the next dt), the load integral of
+ * the current probe interval and the counters. */
+struct coupler_scalars {
+    double time, dt[NPEERS], impulse[MPS_DIM], impulse_time;
+    int64_t step;
+};
+
+static enum mps_status put_coupler(const void *self, struct mps_ckpt *ck, struct mps_err *err)
+{
+    const struct coupler *c = self;
+    struct coupler_scalars sc;
+    memset(&sc, 0, sizeof sc);
+    sc.time = c->time;
+    sc.step = c->step;
+    sc.impulse_time = c->impulse_time;
+    for (int k = 0; k < NPEERS; k++)
+        sc.dt[k] = c->p[k].dt;
+    for (int a = 0; a < MPS_DIM; a++)
+        sc.impulse[a] = c->impulse[a];
+    return mps_ckpt_put(ck, "coupler", &sc, sizeof sc, err);
+}
+
+static enum mps_status get_coupler(struct coupler *c, struct mps_err *err)
+{
+    struct coupler_scalars sc;
+    enum mps_status st = mps_ckpt_get(&c->disk, "coupler", &sc, sizeof sc, err);
+    if (st)
+        return st;
+    c->time = sc.time;
+    c->step = (long)sc.step;
+    c->impulse_time = sc.impulse_time;
+    for (int k = 0; k < NPEERS; k++)
+        c->p[k].dt = sc.dt[k];
+    for (int a = 0; a < MPS_DIM; a++)
+        c->impulse[a] = sc.impulse[a];
+    return MPS_OK;
+}
+
+/* The coupler's part of checkpoint number ++mark.number, written after the
+ * solvers wrote theirs in the step's ADVANCE. */
+static enum mps_status write_checkpoint(struct coupler *c, struct mps_err *err)
+{
+    double t0 = mps_wall_seconds();
+    c->mark.number++;
+    c->mark.steps = c->step;
+    c->mark.table_bytes[0] = mps_probes_bytes(c->probes);
+    enum mps_status st = mps_run_checkpoint(&c->disk, c->out, "coupler", c->case_yaml, &c->mark,
+                                            NULL, c->time, put_coupler, c, err);
+    c->checkpoints += st == MPS_OK;
+    c->t_checkpoint += mps_wall_seconds() - t0;
+    return st;
+}
+
 static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
 {
     const double end = mps_case_double(c->cs, "end_time");
@@ -662,6 +769,12 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
     mps_progress_init(&prog, "coupled", end, c->quiet);
     long out_k = 1, probe_k = 1;
     enum mps_status st;
+    if (c->restart) { /* where the checkpointed run was (start_run read it) */
+        out_k = c->mark.out_k;
+        probe_k = c->mark.probe_k;
+    } else {
+        c->mark.ck_k = 1;
+    }
     /* probe values travel with RESULTs, so the first row is at the first
      * probe time, not at t = 0 */
     while (c->time < end - eps) {
@@ -676,6 +789,10 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
             flags |= PROTO_F_SNAPSHOT;
         if (c->time + dt >= t_probe - eps || c->time + dt >= end - eps)
             flags |= PROTO_F_PROBES;
+        /* like a snapshot: at the end of the first step reaching its time */
+        if (c->ck_interval > 0.0 && c->time + dt >= c->mark.ck_k * c->ck_interval - eps &&
+            c->time + dt < end - eps)
+            flags |= PROTO_F_CHECKPOINT;
 
         struct proto_msg adv = proto_msg_make(PROTO_ADVANCE), res = {0};
         adv.step = c->step;
@@ -724,6 +841,17 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
         if (flags & PROTO_F_SNAPSHOT)
             while (out_k * out_iv <= c->time + eps)
                 out_k++;
+        if (flags & PROTO_F_CHECKPOINT) {
+            mps_run_due(&c->mark.ck_k, c->ck_interval, c->time, eps);
+            c->mark.out_k = out_k;
+            c->mark.probe_k = probe_k;
+            if ((st = write_checkpoint(c, err)))
+                return st;
+            if (c->time >= c->stop_at - eps) {
+                c->stopped_at = c->time;
+                break;
+            }
+        }
         mps_progress_update(&prog, c->time, c->step);
     }
     mps_progress_finish(&prog, c->time, c->step);
@@ -848,6 +976,31 @@ static void write_summary_json(struct coupler *c, enum mps_status st, const stru
     mps_json_num(&j, "coupler_other", wall - solvers - msg);
     mps_json_close(&j);
     mps_json_num(&j, "messaging_fraction", wall > 0.0 ? msg / wall : 0.0);
+    /* checkpoints: the coupler's own cost (each solver's is in its summary)
+     * and where a restarted run came from */
+    mps_json_object(&j, "checkpoints");
+    mps_json_num(&j, "interval", c->ck_interval);
+    if (c->ck_note)
+        mps_json_str(&j, "note", c->ck_note);
+    mps_json_int(&j, "written", c->checkpoints);
+    mps_json_num(&j, "coupler_seconds", c->t_checkpoint);
+    for (int k = 0; k < NPEERS; k++)
+        if (c->p[k].needed && c->p[k].bye) {
+            char key[64];
+            snprintf(key, sizeof key, "%s_seconds", c->p[k].name);
+            mps_json_num(&j, key, bye_number(&c->p[k], "checkpoint_seconds", 0.0));
+            snprintf(key, sizeof key, "%s_bytes", c->p[k].name);
+            mps_json_int(&j, key, (long long)bye_number(&c->p[k], "checkpoint_bytes", 0.0));
+        }
+    mps_json_close(&j);
+    if (c->stopped_at >= 0.0)
+        mps_json_num(&j, "stopped_at", c->stopped_at);
+    if (c->restart) {
+        mps_json_object(&j, "restart");
+        mps_json_str(&j, "checkpoint", c->restart_path);
+        mps_json_num(&j, "time", c->restart_time);
+        mps_json_close(&j);
+    }
     /* iterations per step: 1 for the explicit scheme */
     mps_json_object(&j, "iterations");
     mps_json_str(&j, "scheme", c->implicit ? "implicit" : "explicit");
@@ -980,6 +1133,8 @@ static void cleanup(struct coupler *c)
     mps_probes_close(&c->probes);
     mps_motion_destroy(&c->motion);
     mps_case_destroy(&c->cs);
+    mps_ckpt_free(&c->disk);
+    free(c->case_yaml);
 }
 
 /* Refuses an option that names a solver the case does not need: it would
@@ -1005,7 +1160,8 @@ static int read_command_line(int argc, char **argv, struct mps_cli *cli,
 {
     const char *usage =
         "usage: coupler CASE.yml --out DIR [--set key=value]... [--quiet]\n"
-        "               [--solid \"COMMAND\"] [--fluid \"COMMAND\"] [--external fluid|solid]";
+        "               [--solid \"COMMAND\"] [--fluid \"COMMAND\"] [--external fluid|solid]\n"
+        "       coupler --restart DIR [--from TIME] [--set end_time=T] [--quiet]";
     struct mps_err err = {0};
     enum mps_status st = mps_cli_parse(cli, argc, argv, opt, NOPTS, usage, &err);
     if (st == MPS_EINTR)
@@ -1081,6 +1237,20 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
                            "(solid.eps_max, solid.contact): the interface would change "
                            "within a step");
     free(sc);
+    c->ck_interval = mps_case_double(c->cs, "output.checkpoint_interval");
+    c->ck_asked = strcmp(mps_case_where(c->cs, "output.checkpoint_interval"), "default") != 0;
+    /* the implicit scheme's history (the predictor, the acceleration's
+     * columns and factor, the displacement reference) is not in the
+     * checkpoints: refused when asked, off by default (docs/restart.md) */
+    if (!st && c->implicit && (c->restart || (c->ck_interval > 0.0 && c->ck_asked)))
+        st = mps_case_fail(c->cs, err, "coupling.scheme",
+                           "checkpoints and restarts of implicit coupling are not implemented "
+                           "(its iteration history is not saved): set output.checkpoint_interval"
+                           ": 0, or coupling.scheme: explicit");
+    if (!st && c->implicit && c->ck_interval > 0.0) {
+        c->ck_interval = 0.0;
+        c->ck_note = "off: implicit coupling is not checkpointed";
+    }
     return st;
 }
 
@@ -1151,6 +1321,15 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
             ((st = handshake(c, q, resolved, err)) || (st = await_ready(c, q, err))))
             return st;
     if ((st = open_probes(c, err)))
+        return st;
+    if (!(c->case_yaml = mps_case_resolved_yaml(c->cs)))
+        return mps_err_set(err, MPS_ENOMEM, "coupler: no memory for the resolved case");
+    /* --restart: the solvers restored theirs before READY; now the coupler */
+    if (c->restart && (st = mps_run_get_rest(&c->disk, NULL, err)) == MPS_OK &&
+        (st = get_coupler(c, err)) == MPS_OK && !c->quiet)
+        fprintf(stderr, "coupler: restarting at t = %.9g s (step %ld) from %s\n", c->time,
+                c->step, c->restart_path);
+    if (st)
         return st;
     if (c->implicit && mps_case_bool(c->cs, "coupling.implicit.log")) {
         char path[4200];
@@ -1238,8 +1417,24 @@ int main(int argc, char **argv)
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
 
-    struct coupler c = {0};
+    struct coupler c = {.stopped_at = -1.0, .stop_at = cli.stop_at};
     struct mps_err err = {0};
+    char restart_case[4400];
+    if (cli.restart_dir) {
+        /* the case the checkpoint holds, with --set end_time (mps_restart.h) */
+        enum mps_status rst = mps_run_restart_open(&c.disk, &cli, "coupler", restart_case,
+                                                   sizeof restart_case, &c.mark, &err);
+        if (rst) {
+            fprintf(stderr, "coupler: %s\n", err.msg);
+            mps_ckpt_free(&c.disk);
+            return mps_status_exit_code(rst);
+        }
+        cli.case_path = restart_case;
+        c.restart = c.mark.number;
+        c.restart_time = c.disk.time;
+        mps_ckpt_path(c.restart_path, sizeof c.restart_path, cli.restart_dir, "coupler",
+                      c.restart);
+    }
     c.out = cli.out_dir;
     c.quiet = cli.quiet;
     c.wall0 = mps_wall_seconds();
@@ -1255,6 +1450,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "coupler: %s\n", err.msg);
         mps_motion_destroy(&c.motion);
         mps_case_destroy(&c.cs);
+        mps_ckpt_free(&c.disk);
         return mps_status_exit_code(st);
     }
     if (!(st = start_run(&c, &err)) && !(st = run_loop(&c, &err)))

@@ -1,6 +1,52 @@
 #include "fluid_checkpoint.h"
 
+#include <stdint.h>
 #include <string.h>
+
+/* The scalars, as one block (the order is the format). */
+struct fluid_scalars {
+    uint64_t nfluid, nfixed_end;
+    double time, dt_last, load_scale;
+    int64_t step, lost, wall_guard, solid_placed;
+};
+
+enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    struct fluid_scalars sc = {f->nfluid, f->nfixed_end, f->time, f->dt_last, f->load_scale,
+                               f->step, f->lost, f->wall_guard, f->solid_placed};
+    struct fluid_sensors_mark m;
+    memset(&m, 0, sizeof m); /* padding: the image's bytes depend only on the state */
+    fluid_sensors_keep(f, &m);
+    enum mps_status st;
+    if ((st = mps_particles_put(&f->ps, c, err)) || (st = mps_nbr_list_put(&f->nl, "nl", c, err)) ||
+        (st = mps_nbr_list_put(&f->nl_tank, "nl_tank", c, err)) ||
+        (st = mps_ckpt_put(c, "fluid", &sc, sizeof sc, err)))
+        return st;
+    return mps_ckpt_put(c, "sensors", &m, sizeof m, err);
+}
+
+enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    struct fluid_scalars sc;
+    struct fluid_sensors_mark m;
+    enum mps_status st;
+    if ((st = mps_particles_get(&f->ps, c, err)) || (st = mps_nbr_list_get(&f->nl, "nl", c, err)) ||
+        (st = mps_nbr_list_get(&f->nl_tank, "nl_tank", c, err)) ||
+        (st = mps_ckpt_get(c, "fluid", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_get(c, "sensors", &m, sizeof m, err)))
+        return st;
+    f->nfluid = (size_t)sc.nfluid;
+    f->nfixed_end = (size_t)sc.nfixed_end;
+    f->time = sc.time;
+    f->dt_last = sc.dt_last;
+    f->load_scale = sc.load_scale;
+    f->step = (long)sc.step;
+    f->lost = (long)sc.lost;
+    f->wall_guard = (long)sc.wall_guard;
+    f->solid_placed = (int)sc.solid_placed;
+    fluid_sensors_back(f, &m);
+    return MPS_OK;
+}
 
 enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, struct mps_err *err)
 {
@@ -9,52 +55,22 @@ enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, str
                            "fluid.ppe_solver = cholmod_reuse keeps the ordering of earlier "
                            "solves, so a repeated step would not repeat bit for bit: use "
                            "another solver with coupling.scheme: implicit");
-    enum mps_status st;
-    if ((st = mps_particles_save(&f->ps, &c->ps, err)) ||
-        (st = mps_nbr_list_copy(&c->nl, &f->nl, err)) ||
-        (st = mps_nbr_list_copy(&c->nl_tank, &f->nl_tank, err)))
-        return st;
-    c->nfluid = f->nfluid;
-    c->nfixed_end = f->nfixed_end;
-    c->time = f->time;
-    c->dt_last = f->dt_last;
-    c->load_scale = f->load_scale;
-    c->step = f->step;
-    c->lost = f->lost;
-    c->wall_guard = f->wall_guard;
-    c->solid_placed = f->solid_placed;
-    fluid_sensors_keep(f, &c->sens);
-    c->valid = 1;
-    return MPS_OK;
+    mps_ckpt_clear(&c->img);
+    enum mps_status st = fluid_state_put(f, &c->img, err);
+    c->valid = st == MPS_OK;
+    return st;
 }
 
-enum mps_status fluid_ckpt_restore(struct fluid *f, const struct fluid_ckpt *c,
-                                   struct mps_err *err)
+enum mps_status fluid_ckpt_restore(struct fluid *f, struct fluid_ckpt *c, struct mps_err *err)
 {
     if (!c->valid)
         return mps_err_set(err, MPS_EINPUT, "fluid: restore without a save");
-    enum mps_status st;
-    if ((st = mps_particles_restore(&f->ps, &c->ps, err)) ||
-        (st = mps_nbr_list_copy(&f->nl, &c->nl, err)) ||
-        (st = mps_nbr_list_copy(&f->nl_tank, &c->nl_tank, err)))
-        return st;
-    f->nfluid = c->nfluid;
-    f->nfixed_end = c->nfixed_end;
-    f->time = c->time;
-    f->dt_last = c->dt_last;
-    f->load_scale = c->load_scale;
-    f->step = c->step;
-    f->lost = c->lost;
-    f->wall_guard = c->wall_guard;
-    f->solid_placed = c->solid_placed;
-    fluid_sensors_back(f, &c->sens);
-    return MPS_OK;
+    mps_ckpt_rewind(&c->img);
+    return fluid_state_get(f, &c->img, err);
 }
 
 void fluid_ckpt_free(struct fluid_ckpt *c)
 {
-    mps_particles_ckpt_free(&c->ps);
-    mps_nbr_list_free(&c->nl);
-    mps_nbr_list_free(&c->nl_tank);
-    memset(c, 0, sizeof *c);
+    mps_ckpt_free(&c->img);
+    c->valid = 0;
 }

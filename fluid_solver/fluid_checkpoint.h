@@ -1,8 +1,9 @@
-/* The fluid's state at the start of a coupling step, kept so the step can be
- * repeated from it (implicit coupling, PROTOCOL.md 6): a repeated step with
- * the same solid boundary then gives the same loads bit for bit.
+/* The fluid's complete state, one definition for both uses: implicit
+ * coupling repeats a step from its start (PROTOCOL.md 6, kept in memory) and
+ * a run restarts from a checkpoint file (docs/restart.md). Both write the
+ * state as blocks of an image (mps_ckpt.h) and read it back.
  *
- * What fluid_step reads before it writes it, so what a checkpoint holds:
+ * What fluid_step reads before it writes it, so what the state holds:
  * every particle field in its current order (positions, velocities, the
  * pressure that warm-starts the PPE solve, the positions the Verlet list was
  * built at, the masks), the particle counts of each segment, the Verlet list
@@ -11,34 +12,36 @@
  * (the first step always rebuilds the list; the CFL step reads it), whether
  * the solid has replaced the floor under it, the load normalisation, and the
  * counters of lost particles and guard uses, the sensors' time means
- * (fluid_sensors.h). Work counters (PPE iterations,
- * list rebuilds, phase timers) are not rolled back: they count the work done.
- * The PPE solver keeps no state between solves except with
- * fluid.ppe_solver: cholmod_reuse (the ordering of earlier matrices), which
- * a save therefore refuses. */
+ * (fluid_sensors.h). Work counters (PPE iterations, list rebuilds, phase
+ * timers) are not kept: they count the work done. Everything else (the
+ * grid, the short list, the PPE matrix, pcg_defl's aggregates) is rebuilt
+ * from these at every step. The PPE solver keeps no state between solves
+ * except with fluid.ppe_solver: cholmod_reuse (the ordering of earlier
+ * matrices): a rollback refuses it, and a restart with it is not bit for bit
+ * (docs/restart.md). */
 #ifndef FLUID_CHECKPOINT_H
 #define FLUID_CHECKPOINT_H
 
 #include "fluid.h"
-#include "mps_particles.h"
+#include "mps_ckpt.h"
 
+/* Appends f's state to the image c. */
+enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err);
+/* Reads the next blocks of c (as put) into f, a fluid built from the same
+ * case. */
+enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_err *err);
+
+/* Implicit coupling: the state at the step's start, in memory. */
 struct fluid_ckpt {
     int valid;
-    struct mps_particles_ckpt ps;
-    struct mps_nbr_list nl, nl_tank;
-    size_t nfluid, nfixed_end;
-    double time, dt_last, load_scale;
-    long step, lost, wall_guard;
-    int solid_placed;
-    struct fluid_sensors_mark sens;
+    struct mps_ckpt img;
 };
 
-/* Copies f's state into c (zero-initialised before the first save).
+/* Keeps f's state in c (zero-initialised before the first save).
  * MPS_EINPUT if the fluid's settings cannot be rolled back. */
 enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, struct mps_err *err);
 /* Returns f to the state of the last save. */
-enum mps_status fluid_ckpt_restore(struct fluid *f, const struct fluid_ckpt *c,
-                                   struct mps_err *err);
+enum mps_status fluid_ckpt_restore(struct fluid *f, struct fluid_ckpt *c, struct mps_err *err);
 void fluid_ckpt_free(struct fluid_ckpt *c);
 
 #endif

@@ -288,6 +288,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->wall_layers = (int)mps_case_int(c, "fluid.tank.wall_layers");
     p->output_interval = mps_case_double(c, "output.interval");
     p->probe_interval = mps_case_double(c, "output.probe_interval");
+    p->checkpoint_interval = mps_case_double(c, "output.checkpoint_interval");
 
     if (p->re_lap < p->re_n)
         return mps_case_fail(c, err, "fluid.re_lap", "must be >= fluid.re_n = %g", p->re_n);

@@ -85,7 +85,7 @@ struct fluid_params {
     double block[FLUID_MAX_BLOCKS][4]; /* x0, y0, x1, y1 */
     int nprobes;
     struct fluid_probe_def probes[FLUID_MAX_PROBES];
-    double output_interval, probe_interval;
+    double output_interval, probe_interval, checkpoint_interval;
     /* the tank frame's motion (borrowed from the caller, who reads it with
      * mps_motion_read; fluid_params_read leaves it NULL: a fixed tank) */
     const struct mps_motion *motion;

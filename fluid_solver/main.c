@@ -20,6 +20,7 @@
 #include "mps_omp.h"
 #include "mps_probes.h"
 #include "mps_progress.h"
+#include "mps_restart.h"
 #include "mps_prov.h"
 #include "mps_simd.h"
 #include "mps_timer.h"
@@ -53,10 +54,23 @@ struct run {
     char out_buf[4096];
     char probe_names[4096];
     char cpu_note[96];   /* what mps_omp_bind_threads did (standalone runs) */
+    char prefix[64];     /* of its files: "fluid" */
     /* implicit coupling: the state at the step's start, and the snapshots
      * written by then (a repeated step writes its snapshot again) */
     struct fluid_ckpt ckpt;
     int saved_snapshots;
+    /* checkpoints (docs/restart.md): the image written, the resolved case it
+     * carries, where the outputs stood at the last one */
+    struct mps_ckpt disk;
+    char *case_yaml;
+    struct mps_run_mark mark;
+    int resumed;            /* restarted: the outputs continue from mark */
+    double stop_at;         /* --stop-at */
+    int stopped;            /* stopped there */
+    long checkpoints;       /* written by this process */
+    double t_checkpoint;    /* wall seconds spent writing them */
+    char restart_path[4400]; /* the checkpoint restarted from, or "" */
+    double restart_time;
 };
 
 /* The fluid and its tank, [0, nfixed_end): a coupled solid's particles, the
@@ -94,6 +108,30 @@ static enum mps_status write_step_row(struct run *r, struct mps_err *err)
     return mps_probes_write(r->steps, r->f->time, v, err);
 }
 
+/* A checkpoint at the fluid's time: the run's part (case, counters, where
+ * the tables end, the snapshot index), then the fluid's state. */
+static enum mps_status put_fluid(const void *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    return fluid_state_put(f, c, err);
+}
+
+/* A checkpoint at the fluid's time (mps_restart.h). */
+static enum mps_status write_checkpoint(struct run *r, struct mps_err *err)
+{
+    double t0 = mps_wall_seconds();
+    r->mark.number++;
+    r->mark.steps = r->f->step;
+    r->mark.table_bytes[0] = mps_probes_bytes(r->probes);
+    r->mark.table_bytes[1] = mps_probes_bytes(r->steps);
+    enum mps_status st = mps_run_checkpoint(&r->disk, r->out, r->prefix, r->case_yaml, &r->mark,
+                                            r->h5, r->f->time, put_fluid, r->f, err);
+    if (st)
+        return st;
+    r->checkpoints++;
+    r->t_checkpoint += mps_wall_seconds() - t0;
+    return MPS_OK;
+}
+
 static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
                          const struct mps_err *err)
 {
@@ -114,6 +152,18 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
     mps_json_str(&j, "message", st ? err->msg : "");
     mps_json_num(&j, "wall_seconds", mps_wall_seconds() - r->wall0);
     mps_json_num(&j, "output_seconds", r->t_output);
+    /* checkpoints: their cost, and where a restarted run came from */
+    mps_json_int(&j, "checkpoints", r->checkpoints);
+    mps_json_num(&j, "checkpoint_seconds", r->t_checkpoint);
+    mps_json_int(&j, "checkpoint_bytes", (long long)r->disk.len);
+    if (r->stopped)
+        mps_json_num(&j, "stopped_at", r->f->time);
+    if (r->restart_path[0]) {
+        mps_json_object(&j, "restart");
+        mps_json_str(&j, "checkpoint", r->restart_path);
+        mps_json_num(&j, "time", r->restart_time);
+        mps_json_close(&j);
+    }
     if (r->peer.advances) {
         mps_json_num(&j, "setup_seconds", r->peer.setup_seconds);
         mps_json_num(&j, "compute_seconds", r->peer.compute_seconds);
@@ -181,31 +231,35 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
     struct mps_progress prog;
     mps_progress_init(&prog, "fluid", p->end_time, r->quiet);
     enum mps_status st;
-    if (p->output_interval > 0.0 && (st = write_snapshot(r, err)))
-        return st;
-    if ((st = write_probes(r, err)))
-        return st;
-    long out_k = 1, probe_k = 1;
+    struct mps_run_mark *m = &r->mark;
+    if (!r->resumed) {
+        if (p->output_interval > 0.0 && (st = write_snapshot(r, err)))
+            return st;
+        if ((st = write_probes(r, err)))
+            return st;
+        m->out_k = m->probe_k = m->ck_k = 1;
+    }
     const double eps = 1e-9 * p->end_time;
     while (r->f->time < p->end_time - eps) {
         if (stop_signal)
             return mps_err_set(err, MPS_EINTR, "interrupted by signal %d at t = %.6g s",
                                (int)stop_signal, r->f->time);
-        double t_out = p->output_interval > 0.0 ? out_k * p->output_interval : INFINITY;
         if ((st = fluid_step(r->f, next_dt(r->f, p->end_time), err)) ||
             (st = write_step_row(r, err)))
             return st;
-        if (r->f->time >= probe_k * p->probe_interval - eps) {
-            if ((st = write_probes(r, err)))
+        const double t = r->f->time;
+        if (mps_run_due(&m->probe_k, p->probe_interval, t, eps) && (st = write_probes(r, err)))
+            return st;
+        if (mps_run_due(&m->out_k, p->output_interval, t, eps) && (st = write_snapshot(r, err)))
+            return st;
+        /* last: the checkpoint holds the outputs of this step */
+        if (mps_run_due(&m->ck_k, p->checkpoint_interval, t, eps) && t < p->end_time - eps) {
+            if ((st = write_checkpoint(r, err)))
                 return st;
-            while (probe_k * p->probe_interval <= r->f->time + eps)
-                probe_k++;
-        }
-        if (r->f->time >= t_out - eps) {
-            if ((st = write_snapshot(r, err)))
-                return st;
-            while (out_k * p->output_interval <= r->f->time + eps)
-                out_k++;
+            if (t >= r->stop_at - eps) {
+                r->stopped = 1;
+                break;
+            }
         }
         mps_progress_update(&prog, r->f->time, r->f->step);
     }
@@ -237,17 +291,20 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
     prm.motion = r->motion;
     if ((st = fluid_create(&r->f, &prm, err)))
         return st;
-    char *yaml = mps_case_resolved_yaml(r->cs);
+    r->case_yaml = mps_case_resolved_yaml(r->cs);
+    if (!r->case_yaml)
+        return mps_err_set(err, MPS_ENOMEM, "fluid: no memory for the resolved case");
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", r->out);
     const char *names[FLUID_MAX_PROBES];
     for (int k = 0; k < prm.nprobes; k++)
         names[k] = prm.probes[k].name;
     proto_join_names(names, prm.nprobes, r->probe_names, sizeof r->probe_names);
-    st = mps_h5_open(&r->h5, r->out, prefix, "fluid_solver", yaml ? yaml : "", err);
-    free(yaml);
+    st = mps_h5_open(&r->h5, r->out, prefix, "fluid_solver", r->case_yaml, err);
     /* under the coupler, probes travel in RESULT and the coupler writes them */
-    if (!st && !r->coupled) {
+    if (!st && !r->coupled && r->resumed) {
+        st = mps_probes_resume(&r->probes, path, r->mark.table_bytes[0], prm.nprobes, err);
+    } else if (!st && !r->coupled) {
         char *comment = mps_prov_comment(r->cs, "fluid_solver");
         st = mps_probes_open(&r->probes, path, comment, names, prm.nprobes, err);
         free(comment);
@@ -256,11 +313,40 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
         static const char *const cols[6] = {"dt", "ppe_iterations", "ppe_rows",
                                             "rows_at_zero", "collision_pairs", "neighbour_build"};
         snprintf(path, sizeof path, "%s/%s_steps.csv", r->out, prefix);
+        if (r->resumed)
+            return mps_probes_resume(&r->steps, path, r->mark.table_bytes[1], 6, err);
         char *comment = mps_prov_comment(r->cs, "fluid_solver");
         st = mps_probes_open(&r->steps, path, comment, cols, 6, err);
         free(comment);
     }
     return st;
+}
+
+/* A new run from the case, or with --restart the run in its directory from
+ * its checkpoint: the case the checkpoint holds, the outputs continued where
+ * it was taken, the fluid's state read back. */
+static enum mps_status restart_or_setup(struct run *r, const struct mps_cli *cli,
+                                        struct mps_err *err)
+{
+    if (!cli->restart_dir)
+        return setup(r, cli->case_path, cli->sets, cli->nsets, "fluid", err);
+    char case_path[4400];
+    enum mps_status st = mps_run_restart_open(&r->disk, cli, "fluid", case_path,
+                                              sizeof case_path, &r->mark, err);
+    if (st)
+        return st;
+    r->resumed = 1;
+    mps_ckpt_path(r->restart_path, sizeof r->restart_path, cli->restart_dir, "fluid",
+                  r->mark.number);
+    r->restart_time = r->disk.time;
+    if ((st = setup(r, case_path, cli->sets, cli->nsets, "fluid", err)) ||
+        (st = mps_run_get_rest(&r->disk, r->h5, err)) ||
+        (st = fluid_state_get(r->f, &r->disk, err)))
+        return st;
+    if (!cli->quiet)
+        fprintf(stderr, "fluid_solver: restarting %s at t = %.9g s (step %ld)\n", cli->restart_dir,
+                r->f->time, r->f->step);
+    return MPS_OK;
 }
 
 static enum mps_status peer_configure(void *self, const char *case_path, const char *out_dir,
@@ -269,10 +355,39 @@ static enum mps_status peer_configure(void *self, const char *case_path, const c
     struct run *r = self;
     snprintf(r->out_buf, sizeof r->out_buf, "%s", out_dir);
     r->out = r->out_buf;
-    enum mps_status st = setup(r, case_path, NULL, 0, prefix, err);
-    if (!st && r->f->prm.output_interval > 0.0)
+    snprintf(r->prefix, sizeof r->prefix, "%s", prefix);
+    enum mps_status st;
+    /* CONFIG restart=N: where the outputs stood (the step log continues) */
+    if (r->peer.restart &&
+        (st = mps_run_read(&r->disk, out_dir, prefix, r->peer.restart, &r->mark, err)))
+        return st;
+    r->resumed = r->peer.restart > 0;
+    st = setup(r, case_path, NULL, 0, prefix, err);
+    if (!st && !r->resumed && r->f->prm.output_interval > 0.0)
         st = write_snapshot(r, err);
     return st;
+}
+
+/* caps=checkpoint (proto_solver.h): the same checkpoint as a run alone. */
+static enum mps_status peer_checkpoint(void *self, long number, double time,
+                                       struct mps_err *err)
+{
+    struct run *r = self;
+    r->mark.number = number - 1; /* write_checkpoint counts it */
+    (void)time;                  /* the fluid's own time is the coupler's (peer_advance) */
+    return write_checkpoint(r, err);
+}
+
+static enum mps_status peer_resume(void *self, long number, struct mps_err *err)
+{
+    struct run *r = self;
+    enum mps_status st;
+    if ((st = mps_run_get_rest(&r->disk, r->h5, err)) ||
+        (st = fluid_state_get(r->f, &r->disk, err)))
+        return st;
+    mps_ckpt_path(r->restart_path, sizeof r->restart_path, r->out, r->prefix, number);
+    r->restart_time = r->f->time;
+    return MPS_OK;
 }
 
 static enum mps_status peer_ready(void *self, struct proto_msg *reply, struct mps_err *err)
@@ -364,6 +479,8 @@ static void teardown(struct run *r)
     mps_h5_close(&r->h5);
     fluid_destroy(&r->f);
     fluid_ckpt_free(&r->ckpt);
+    mps_ckpt_free(&r->disk);
+    free(r->case_yaml);
     mps_motion_destroy(&r->motion);
     mps_case_destroy(&r->cs);
     free(r->load_id);
@@ -373,12 +490,14 @@ static void teardown(struct run *r)
 
 static int run_coupled(const char *endpoint, int hello_timeout_ms)
 {
-    struct run r = {.out = ".", .quiet = 1, .summary_name = "fluid_summary.json", .coupled = 1};
+    struct run r = {.out = ".", .quiet = 1, .summary_name = "fluid_summary.json", .coupled = 1,
+                    .prefix = "fluid"};
     r.wall0 = mps_wall_seconds();
     struct mps_err err = {0};
     static const struct proto_solver_ops ops = {"fluid",     "mps",       peer_configure,
                                                 peer_ready,  peer_advance, peer_finish,
-                                                peer_save,   peer_restore, 1};
+                                                peer_save,   peer_restore, 1,
+                                                peer_checkpoint, peer_resume};
     enum mps_status st =
         proto_solver_run(endpoint, &ops, &r, hello_timeout_ms, &stop_signal, &r.peer, &err);
     if (st)
@@ -421,10 +540,12 @@ int main(int argc, char **argv)
         fprintf(stderr, "fluid_solver: missing --out DIR (see --help)\n");
         return 2;
     }
-    struct run r = {.out = cli.out_dir, .quiet = cli.quiet, .summary_name = "summary.json"};
+    struct run r = {.out = cli.out_dir, .quiet = cli.quiet, .summary_name = "summary.json",
+                    .prefix = "fluid",
+                    .stop_at = cli.stop_at};
     r.wall0 = mps_wall_seconds();
     mps_omp_bind_threads(r.cpu_note, sizeof r.cpu_note);
-    st = setup(&r, cli.case_path, cli.sets, cli.nsets, "fluid", &err);
+    st = restart_or_setup(&r, &cli, &err);
     if (st == MPS_OK) {
         if (extra[0].value) {
             /* benchmark aid: run to step N and dump its PPE */

@@ -399,12 +399,14 @@ static enum mps_status check_msg(const struct proto_msg *m, struct mps_err *err)
     }
     if (!payload_ok)
         return bad(err, m, "payload %s not allowed", proto_payload_name(m->payload));
-    uint32_t known = PROTO_F_TEXT | PROTO_F_SNAPSHOT | PROTO_F_PROBES;
+    uint32_t known = PROTO_F_TEXT | PROTO_F_SNAPSHOT | PROTO_F_PROBES | PROTO_F_CHECKPOINT;
     if (m->flags & ~known)
         return bad(err, m, "flags 0x%" PRIx32 " have unknown bits 0x%" PRIx32, m->flags,
                    m->flags & ~known);
     if ((m->flags & PROTO_F_SNAPSHOT) && t != PROTO_ADVANCE)
         return bad(err, m, "flag SNAPSHOT is for ADVANCE only");
+    if ((m->flags & PROTO_F_CHECKPOINT) && t != PROTO_ADVANCE)
+        return bad(err, m, "flag CHECKPOINT is for ADVANCE only");
     if ((m->flags & PROTO_F_PROBES) && t != PROTO_ADVANCE && t != PROTO_RESULT)
         return bad(err, m, "flag PROBES is for ADVANCE and RESULT only");
     int text_rule; /* 1 required, 0 forbidden, -1 optional */

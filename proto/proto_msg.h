@@ -45,7 +45,8 @@ enum proto_payload {
 enum {
     PROTO_F_TEXT = 1u,      /* set by the encoder iff text != NULL */
     PROTO_F_SNAPSHOT = 2u,  /* ADVANCE: write a snapshot after the step */
-    PROTO_F_PROBES = 4u     /* ADVANCE: return probes; RESULT: probe frame present */
+    PROTO_F_PROBES = 4u,    /* ADVANCE: return probes; RESULT: probe frame present */
+    PROTO_F_CHECKPOINT = 8u /* ADVANCE: write a checkpoint after the step (caps=checkpoint) */
 };
 
 struct proto_msg {

@@ -135,8 +135,13 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
 
     char hello[256];
     const int can_roll = ops->save && ops->restore;
+    const int can_ckpt = ops->checkpoint && ops->resume;
     snprintf(hello, sizeof hello, "role=%s model=%s pid=%d build=%s%s", ops->role, ops->model,
-             (int)getpid(), MPS_VERSION, can_roll ? " caps=rollback" : "");
+             (int)getpid(), MPS_VERSION,
+             can_roll && can_ckpt ? " caps=rollback,checkpoint"
+             : can_roll           ? " caps=rollback"
+             : can_ckpt           ? " caps=checkpoint"
+                                  : "");
     reply = proto_msg_make(PROTO_HELLO);
     reply.text = hello;
     if ((st = proto_link_send(sock, &reply, err)))
@@ -173,10 +178,11 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
             size_t len = end ? (size_t)(end - line) : strlen(line);
             size_t klen = eq && (size_t)(eq - line) < len ? (size_t)(eq - line) : len;
             static const char *const known[] = {"case", "out", "prefix", "timeout_ms",
-                                                "rollback"};
+                                                "rollback", "restart"};
             int ok = len == 0;
-            for (int k = 0; k < (can_roll ? 5 : 4) && !ok; k++)
-                ok = strlen(known[k]) == klen && strncmp(line, known[k], klen) == 0;
+            for (int k = 0; k < 6 && !ok; k++)
+                ok = (k < 4 || (k == 4 && can_roll) || (k == 5 && can_ckpt)) &&
+                     strlen(known[k]) == klen && strncmp(line, known[k], klen) == 0;
             if (!ok && klen == 6 && strncmp(line, "motion", 6) == 0) {
                 /* PROTOCOL.md 4: the case's tank moves; a solver that cannot
                  * apply the moving frame says so rather than run a fixed tank */
@@ -203,9 +209,22 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
             }
             stats->rollback = strcmp(roll, "on") == 0;
         }
+        char rs[32];
+        if (can_ckpt && proto_text_get(in.text, '\n', "restart", rs, sizeof rs) != 0) {
+            char *e = NULL;
+            long n = strtol(rs, &e, 10);
+            if (e == rs || *e || n < 1) {
+                st = mps_err_set(err, MPS_EINPUT, "CONFIG restart=%.20s: must be a checkpoint "
+                                 "number >= 1", rs);
+                goto fail;
+            }
+            stats->restart = stats->checkpoints = n;
+        }
         double t0 = mps_wall_seconds();
         st = ops->configure(self, case_path, out, prefix, err);
         configured = 1;
+        if (!st && stats->restart)
+            st = ops->resume(self, stats->restart, err);
         /* the first save refuses a scene the solver cannot roll back, before READY */
         if (!st && stats->rollback)
             st = ops->save(self, err);
@@ -254,6 +273,19 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         stats->rollback_seconds += t1 - t0;
         reply = proto_msg_make(PROTO_RESULT);
         st = ops->advance(self, &in, &reply, err);
+        if (!st && (in.flags & PROTO_F_CHECKPOINT)) {
+            if (!can_ckpt) {
+                st = mps_err_set(err, MPS_EPROTO, "ADVANCE step %lld asks for a checkpoint: "
+                                 "this solver declared no caps=checkpoint", (long long)in.step);
+                goto fail;
+            }
+            /* a repeated iteration rewrites the step's checkpoint */
+            if (in.iteration == 0)
+                stats->checkpoints++;
+            double t2 = mps_wall_seconds();
+            st = ops->checkpoint(self, stats->checkpoints, in.time + in.dt, err);
+            stats->checkpoint_seconds += mps_wall_seconds() - t2;
+        }
         stats->compute_seconds += mps_wall_seconds() - t0;
         stats->advances++;
         if (st)

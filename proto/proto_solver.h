@@ -42,6 +42,15 @@ struct proto_solver_ops {
      * mps_motion.h), so it accepts CONFIG motion=KIND; 0: it answers that key
      * with ERROR input (PROTOCOL.md 4). */
     int moving_frame;
+    /* Optional, both or neither: checkpoints (PROTOCOL.md 6, "Checkpoints";
+     * docs/restart.md). A solver with them declares caps=checkpoint in HELLO.
+     * checkpoint writes the solver's complete state after the step of an
+     * ADVANCE with PROTO_F_CHECKPOINT as checkpoint number (the loop counts
+     * them from CONFIG restart=N, or 0); resume, called after configure when
+     * CONFIG has restart=N, reads checkpoint N back (state and outputs), so
+     * READY then reports the state of that moment. */
+    enum mps_status (*checkpoint)(void *self, long number, double time, struct mps_err *err);
+    enum mps_status (*resume)(void *self, long number, struct mps_err *err);
 };
 
 /* Timing of the conversation, for the solver's summary. */
@@ -53,6 +62,9 @@ struct proto_solver_stats {
     long advances;            /* every ADVANCE, repeated iterations included */
     long repeats;             /* ADVANCEs with iteration > 0 */
     int rollback;             /* CONFIG asked for rollback=on */
+    long restart;             /* CONFIG restart=N (0: a new run), set before configure */
+    long checkpoints;         /* the last checkpoint's number */
+    double checkpoint_seconds; /* inside checkpoint (part of compute_seconds) */
 };
 
 /* Runs the conversation on endpoint until STOP (MPS_OK), ABORT (MPS_EPEER),

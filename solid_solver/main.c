@@ -20,6 +20,7 @@
 #include "mps_probes.h"
 #include "mps_progress.h"
 #include "mps_prov.h"
+#include "mps_restart.h"
 #include "mps_timer.h"
 #include "mps_version.h"
 #include "proto_solver.h"
@@ -44,7 +45,29 @@ struct run {
     double *pvals;
     int nprobes;
     double t_output;   /* wall seconds spent writing */
+    /* checkpoints (docs/restart.md) */
+    struct mps_ckpt disk;
+    struct mps_run_mark mark;
+    long checkpoints;
+    double t_checkpoint;
+    double stopped_at;        /* --stop-at stopped the run here, or -1 */
+    char restart_path[4400];  /* the checkpoint restarted from, or "" */
+    double restart_time;
 };
+
+static enum mps_status write_checkpoint(struct run *r, const char *dir, const char *yaml,
+                                        double t, long step, struct mps_err *err)
+{
+    double w0 = mps_wall_seconds();
+    r->mark.number++;
+    r->mark.steps = step;
+    r->mark.table_bytes[0] = mps_probes_bytes(r->probes);
+    enum mps_status st = mps_run_checkpoint(&r->disk, dir, "solid", yaml, &r->mark, r->h5, t,
+                                            r->ops->state_put, r->model, err);
+    r->checkpoints += st == MPS_OK;
+    r->t_checkpoint += mps_wall_seconds() - w0;
+    return st;
+}
 
 static enum mps_status write_snapshot(struct run *r, double t, long step, struct mps_err *err)
 {
@@ -92,6 +115,17 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
     mps_json_num(&j, "wall_seconds", wall_total);
     mps_json_num(&j, "step_seconds", wall_loop);
     mps_json_num(&j, "output_seconds", r->t_output);
+    mps_json_int(&j, "checkpoints", r->checkpoints);
+    mps_json_num(&j, "checkpoint_seconds", r->t_checkpoint);
+    mps_json_int(&j, "checkpoint_bytes", (long long)r->disk.len);
+    if (r->stopped_at >= 0.0)
+        mps_json_num(&j, "stopped_at", r->stopped_at);
+    if (r->restart_path[0]) {
+        mps_json_object(&j, "restart");
+        mps_json_str(&j, "checkpoint", r->restart_path);
+        mps_json_num(&j, "time", r->restart_time);
+        mps_json_close(&j);
+    }
     double ps = (double)n * (double)steps;
     mps_json_num(&j, "ns_per_particle_step", ps > 0 ? 1e9 * wall_loop / ps : NAN);
     mps_json_num(&j, "particle_steps_per_second", wall_loop > 0 ? ps / wall_loop : NAN);
@@ -137,10 +171,32 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     }
     mps_prov_sets(sets, &nsets, MPS_CLI_MAX_SETS + 1 + MPS_PROV_NSETS);
     struct mps_case *c = NULL;
-    enum mps_status st = mps_case_load(&c, cli->case_path, sets, nsets, tables, 3, ignore, err);
-    if (st != MPS_OK)
+    struct run r = {.stopped_at = -1.0};
+    /* --restart: the case the checkpoint holds (mps_restart.h) */
+    const char *case_path = cli->case_path;
+    char restart_case[4400];
+    enum mps_status st = MPS_OK;
+    if (cli->restart_dir) {
+        if (model_name)
+            st = mps_err_set(err, MPS_EINPUT, "--model with --restart: the model is the "
+                             "checkpoint's");
+        else
+            st = mps_run_restart_open(&r.disk, cli, "solid", restart_case, sizeof restart_case,
+                                      &r.mark, err);
+        if (st) {
+            mps_ckpt_free(&r.disk);
+            return st;
+        }
+        case_path = restart_case;
+        mps_ckpt_path(r.restart_path, sizeof r.restart_path, cli->restart_dir, "solid",
+                      r.mark.number);
+        r.restart_time = r.disk.time;
+    }
+    st = mps_case_load(&c, case_path, sets, nsets, tables, 3, ignore, err);
+    if (st != MPS_OK) {
+        mps_ckpt_free(&r.disk);
         return st;
-    struct run r = {0};
+    }
     char *yaml = NULL;
     /* solid.model's choices are the models' names */
     r.ops = solid_model_find(mps_case_string(c, "solid.model"));
@@ -156,6 +212,7 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     const double end = mps_case_double(c, "end_time");
     const double out_dt = mps_case_double(c, "output.interval");
     const double probe_dt = mps_case_double(c, "output.probe_interval");
+    const double ck_dt = mps_case_double(c, "output.checkpoint_interval");
     yaml = mps_case_resolved_yaml(c);
     if (out_dt > 0.0 &&
         (st = mps_h5_open(&r.h5, cli->out_dir, "solid", "solid_solver", yaml, err)) != MPS_OK)
@@ -172,12 +229,24 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
         names[k] = r.ops->probe_name(r.model, k);
     char path[4096];
     snprintf(path, sizeof path, "%s/probes.csv", cli->out_dir);
-    char *comment = mps_prov_comment(c, "solid_solver");
-    st = mps_probes_open(&r.probes, path, comment, names, r.nprobes, err);
-    free(comment);
+    if (cli->restart_dir) {
+        st = mps_probes_resume(&r.probes, path, r.mark.table_bytes[0], r.nprobes, err);
+    } else {
+        char *comment = mps_prov_comment(c, "solid_solver");
+        st = mps_probes_open(&r.probes, path, comment, names, r.nprobes, err);
+        free(comment);
+    }
     free(names);
     if (st != MPS_OK)
         goto done;
+    if (cli->restart_dir && ((st = mps_run_get_rest(&r.disk, r.h5, err)) != MPS_OK ||
+                             (st = r.ops->state_get(r.model, &r.disk, err)) != MPS_OK))
+        goto done;
+    if (!r.ops->state_put && ck_dt > 0.0) {
+        st = mps_err_set(err, MPS_EINPUT, "output.checkpoint_interval = %g: the solid model %s "
+                         "cannot checkpoint (set it to 0)", ck_dt, r.ops->name);
+        goto done;
+    }
 
     const double(*x)[MPS_DIM] = NULL;
     struct mps_field f[MAX_FIELDS];
@@ -191,14 +260,26 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     struct mps_progress prog;
     mps_progress_init(&prog, "solid", end, cli->quiet);
     double t = 0.0, wall_loop = 0.0;
-    long step = 0, kout = 0, kprobe = 0;
+    long step = 0, kout = 1, kprobe = 1, kck = 1;
     double last_snapshot = -1.0;
-    if (r.h5 && (st = write_snapshot(&r, t, step, err)) != MPS_OK)
-        goto done;
-    last_snapshot = 0.0;
-    if ((st = write_probes(&r, t, err)) != MPS_OK)
-        goto done;
-    kout = kprobe = 1;
+    const double eps = 1e-9 * end;
+    if (cli->restart_dir) {
+        /* exactly where the checkpointed run was, its next events included */
+        t = r.disk.time;
+        step = r.mark.steps;
+        kout = r.mark.out_k;
+        kprobe = r.mark.probe_k;
+        kck = r.mark.ck_k;
+        if (!cli->quiet)
+            fprintf(stderr, "solid_solver: restarting %s at t = %.9g s (step %ld)\n",
+                    cli->restart_dir, t, step);
+    } else {
+        if (r.h5 && (st = write_snapshot(&r, t, step, err)) != MPS_OK)
+            goto done;
+        last_snapshot = 0.0;
+        if ((st = write_probes(&r, t, err)) != MPS_OK)
+            goto done;
+    }
     while (t < end) {
         double t_out = event(kout, out_dt), t_probe = event(kprobe, probe_dt);
         double target = fmin(fmin(t_out, t_probe), end);
@@ -230,6 +311,18 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
         }
         if (t >= t_out)
             kout++;
+        /* after the outputs of t, which the checkpoint then includes */
+        r.mark.out_k = kout;
+        r.mark.probe_k = kprobe;
+        if (mps_run_due(&kck, ck_dt, t, eps) && t < end - eps) {
+            r.mark.ck_k = kck;
+            if ((st = write_checkpoint(&r, cli->out_dir, yaml, t, step, err)) != MPS_OK)
+                goto done;
+            if (t >= cli->stop_at - eps) {
+                r.stopped_at = t;
+                break;
+            }
+        }
         mps_progress_update(&prog, t, step);
     }
     mps_progress_finish(&prog, t, step);
@@ -243,6 +336,7 @@ done:
     mps_h5_close(&r.h5);
     free(r.pvals);
     free(yaml);
+    mps_ckpt_free(&r.disk);
     if (r.ops && r.model)
         r.ops->destroy(&r.model);
     mps_case_destroy(&c);

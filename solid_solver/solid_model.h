@@ -8,6 +8,7 @@
 #include <stddef.h>
 
 #include "mps_case.h"
+#include "mps_ckpt.h"
 #include "mps_dim.h"
 #include "mps_err.h"
 #include "mps_h5.h"
@@ -76,15 +77,19 @@ struct solid_model_ops {
     /* Extra summary members (phase times, counters) into an open JSON object. */
     void (*summary)(const void *self, struct mps_json *j);
     void (*destroy)(void **self);
-    /* Optional, both or neither (NULL: the model cannot roll back). For
-     * implicit coupling, which repeats a coupling step from its start: save
-     * keeps every part of the state that advance reads (particles, rotations,
-     * damping history, time and step counters); restore returns to the last
-     * save, so that the same loads then give the same state bit for bit.
-     * save fails with MPS_EINPUT, saying why, for a scene the model cannot
-     * roll back. */
-    enum mps_status (*save)(void *self, struct mps_err *err);
-    enum mps_status (*restore)(void *self, struct mps_err *err);
+    /* The model's complete state, one definition for implicit coupling's
+     * rollback (a repeated step restarts from it, in memory) and for
+     * checkpoints (docs/restart.md): every part of the state that advance
+     * reads (particles, rotations, bonds and broken bonds, contact lists,
+     * time and step counters, the load probes' means) as blocks of an image
+     * (mps_ckpt.h), and back into a model built from the same case, after
+     * which the same loads give the same state bit for bit. Optional, both
+     * or neither (NULL: the model cannot checkpoint or roll back). */
+    enum mps_status (*state_put)(const void *self, struct mps_ckpt *c, struct mps_err *err);
+    enum mps_status (*state_get)(void *self, struct mps_ckpt *c, struct mps_err *err);
+    /* Optional: MPS_EINPUT, saying why, for a scene whose steps cannot be
+     * repeated under implicit coupling although its state can be saved. */
+    enum mps_status (*rollback_check)(const void *self, struct mps_err *err);
 };
 
 /* The models compiled in, by name; NULL if unknown. */

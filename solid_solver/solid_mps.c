@@ -1,6 +1,7 @@
 #include "solid_mps.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -277,7 +278,6 @@ void solid_mps_destroy(struct solid_mps **sp)
     free(s->bbr);
     free(s->vold);
     free(s->wold);
-    mps_particles_ckpt_free(&s->ckpt);
     solid_iface_cache_free(&s->iface);
     mps_motion_destroy(&s->motion);
     free(s);
@@ -625,33 +625,75 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_close(j);
 }
 
-/* The damping history (vold, wold) is rewritten at the start of every step
- * and the loads by set_loads, so the particle fields, time and steps are the
- * whole state. Fracture changes bonds, surface and contact lists, and the
- * interface's size; rolling those back is not done. */
-static enum mps_status op_save(void *self, struct mps_err *err)
+/* The state (solid_model_ops.state_put). The damping history (vold, wold)
+ * is rewritten at the start of every step and the loads by set_loads, so
+ * without fracture the particle fields, time, steps and the load probes'
+ * means are the whole state. Fracture adds the bonds' stiffnesses (zero
+ * once broken), the surface counter and the contact list
+ * (solid_mps_frac_put); the surface flags and the number densities of the
+ * intact bonds are particle fields. */
+struct mps_scalars {
+    double time;
+    int64_t steps, surface_rev;
+};
+
+static enum mps_status op_state_put(const void *self, struct mps_ckpt *c, struct mps_err *err)
+{
+    const struct solid_mps *s = self;
+    struct mps_scalars sc = {s->time, s->steps, s->surface_rev};
+    struct solid_load_probes_mark m;
+    memset(&m, 0, sizeof m);
+    solid_load_probes_keep(&s->loadprobes, &m);
+    enum mps_status st;
+    if ((st = mps_particles_put(&s->ps, c, err)) ||
+        (st = mps_ckpt_put(c, "mps", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_put(c, "load_probes", &m, sizeof m, err)) || !s->frac)
+        return st;
+    const size_t nb = s->nbonds * sizeof(double);
+    if ((st = mps_ckpt_put(c, "bonds.k", s->bk, nb, err)) ||
+        (st = mps_ckpt_put(c, "bonds.beta", s->bb, nb, err)) ||
+        (st = mps_ckpt_put(c, "bonds.beta_r", s->bbr, nb, err)))
+        return st;
+    return solid_mps_frac_put(s, c, err);
+}
+
+static enum mps_status op_state_get(void *self, struct mps_ckpt *c, struct mps_err *err)
 {
     struct solid_mps *s = self;
+    struct mps_scalars sc;
+    struct solid_load_probes_mark m;
+    enum mps_status st;
+    if ((st = mps_particles_get(&s->ps, c, err)) ||
+        (st = mps_ckpt_get(c, "mps", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_get(c, "load_probes", &m, sizeof m, err)))
+        return st;
+    s->time = sc.time;
+    s->steps = (long)sc.steps;
+    s->surface_rev = (long)sc.surface_rev;
+    s->iface_rev = -1; /* the interface is listed again from the state read */
+    solid_load_probes_back(&s->loadprobes, &m);
+    if (!s->frac)
+        return MPS_OK;
+    const size_t nb = s->nbonds * sizeof(double);
+    if ((st = mps_ckpt_get(c, "bonds.k", s->bk, nb, err)) ||
+        (st = mps_ckpt_get(c, "bonds.beta", s->bb, nb, err)) ||
+        (st = mps_ckpt_get(c, "bonds.beta_r", s->bbr, nb, err)))
+        return st;
+    return solid_mps_frac_get(s, c, err);
+}
+
+/* Fracture changes bonds, surface and contact lists, and the interface's
+ * size within a step: a coupling iteration would see a solid of another
+ * shape at each repeat. */
+static enum mps_status op_rollback_check(const void *self, struct mps_err *err)
+{
+    const struct solid_mps *s = self;
     if (s->frac)
         return mps_err_set(err, MPS_EINPUT,
                            "solid: fracture or contact (solid.eps_max, solid.contact) cannot be "
                            "rolled back: implicit coupling (coupling.scheme: implicit) needs "
                            "them off");
-    s->ckpt_time = s->time;
-    s->ckpt_steps = s->steps;
-    solid_load_probes_keep(&s->loadprobes, &s->ckpt_loadprobes);
-    return mps_particles_save(&s->ps, &s->ckpt, err);
-}
-
-static enum mps_status op_restore(void *self, struct mps_err *err)
-{
-    struct solid_mps *s = self;
-    if (!s->ckpt.nfields)
-        return mps_err_set(err, MPS_EINPUT, "solid: restore without a save");
-    s->time = s->ckpt_time;
-    s->steps = s->ckpt_steps;
-    solid_load_probes_back(&s->loadprobes, &s->ckpt_loadprobes);
-    return mps_particles_restore(&s->ps, &s->ckpt, err);
+    return MPS_OK;
 }
 
 static void op_destroy(void **self)
@@ -675,6 +717,7 @@ const struct solid_model_ops solid_mps_ops = {
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
-    .save = op_save,
-    .restore = op_restore,
+    .state_put = op_state_put,
+    .state_get = op_state_get,
+    .rollback_check = op_rollback_check,
 };

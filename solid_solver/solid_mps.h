@@ -139,12 +139,6 @@ struct solid_mps {
     long steps;
     struct mps_timer timer;
 
-    /* rollback (solid_model_ops.save/restore): every particle field, time
-     * and steps; the bonds do not change without fracture, which it refuses */
-    struct mps_particles_ckpt ckpt;
-    double ckpt_time;
-    long ckpt_steps;
-    struct solid_load_probes_mark ckpt_loadprobes;
 };
 
 /* Builds particles, bonds, clamps and probes from a scene (copied). */

@@ -1,6 +1,7 @@
 #include "solid_mps_fracture.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -401,6 +402,75 @@ double solid_mps_min_gap(const struct solid_mps *s, double radius)
     }
     hgrid_free(&g);
     return best;
+}
+
+struct frac_scalars {
+    int64_t broken, valid, built_broken, builds, active_max, m, np;
+    double gap_min;
+};
+
+enum mps_status solid_mps_frac_put(const struct solid_mps *s, struct mps_ckpt *c,
+                                   struct mps_err *err)
+{
+    const struct solid_mps_frac *f = s->frac;
+    struct frac_scalars sc = {f->broken, f->valid, f->built_broken, f->builds, f->active_max,
+                              (int64_t)f->m, (int64_t)f->np, f->gap_min};
+    enum mps_status st;
+    if ((st = mps_ckpt_put(c, "fracture", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_put(c, "contact.sidx", f->sidx, f->m * sizeof *f->sidx, err)) ||
+        (st = mps_ckpt_put(c, "contact.sx", f->sx, f->m * sizeof *f->sx, err)) ||
+        (st = mps_ckpt_put(c, "contact.pair", f->pair, f->np * sizeof *f->pair, err)))
+        return st;
+    return mps_ckpt_put(c, "contact.k", f->pk, f->np * sizeof *f->pk, err);
+}
+
+enum mps_status solid_mps_frac_get(struct solid_mps *s, struct mps_ckpt *c, struct mps_err *err)
+{
+    struct solid_mps_frac *f = s->frac;
+    struct frac_scalars sc;
+    enum mps_status st = mps_ckpt_get(c, "fracture", &sc, sizeof sc, err);
+    if (st)
+        return st;
+    if (sc.m < 0 || (size_t)sc.m > s->n || sc.np < 0)
+        return mps_err_set(err, MPS_EINPUT, "checkpoint: contact list of %lld particles, "
+                           "%lld pairs, for %zu particles", (long long)sc.m, (long long)sc.np,
+                           s->n);
+    size_t m = (size_t)sc.m, np = (size_t)sc.np;
+    if (m > f->cap_m) {
+        size_t *si = realloc(f->sidx, m * sizeof *si);
+        if (si)
+            f->sidx = si;
+        double(*sx)[MPS_DIM] = realloc(f->sx, m * sizeof *sx);
+        if (sx)
+            f->sx = sx;
+        if (!si || !sx)
+            return mps_err_set(err, MPS_ENOMEM, "solid: no memory for %zu contact particles", m);
+        f->cap_m = m;
+    }
+    while (np > f->cap_p)
+        if ((st = grow_pairs(f, err)))
+            return st;
+    if ((st = mps_ckpt_get(c, "contact.sidx", f->sidx, m * sizeof *f->sidx, err)) ||
+        (st = mps_ckpt_get(c, "contact.sx", f->sx, m * sizeof *f->sx, err)) ||
+        (st = mps_ckpt_get(c, "contact.pair", f->pair, np * sizeof *f->pair, err)) ||
+        (st = mps_ckpt_get(c, "contact.k", f->pk, np * sizeof *f->pk, err)))
+        return st;
+    for (size_t k = 0; k < np; k++)
+        if (f->pair[k][0] < 0 || (size_t)f->pair[k][0] >= s->n || f->pair[k][1] < 0 ||
+            (size_t)f->pair[k][1] >= s->n)
+            return mps_err_set(err, MPS_EINPUT, "checkpoint: contact pair %zu out of range", k);
+    for (size_t k = 0; k < m; k++)
+        if (f->sidx[k] >= s->n)
+            return mps_err_set(err, MPS_EINPUT, "checkpoint: contact particle %zu out of range", k);
+    f->m = m;
+    f->np = np;
+    f->broken = sc.broken;
+    f->valid = (int)sc.valid;
+    f->built_broken = sc.built_broken;
+    f->builds = sc.builds;
+    f->active_max = sc.active_max;
+    f->gap_min = sc.gap_min;
+    return MPS_OK;
 }
 
 void solid_mps_frac_stats(const struct solid_mps *s, struct solid_mps_frac_stats *st)

@@ -54,6 +54,7 @@
 #ifndef SOLID_MPS_FRACTURE_H
 #define SOLID_MPS_FRACTURE_H
 
+#include "mps_ckpt.h"
 #include "mps_err.h"
 #include "mps_json.h"
 
@@ -86,6 +87,14 @@ double solid_mps_min_gap(const struct solid_mps *s, double radius);
 
 /* 1 if bond b (an index into s->bj) is intact. */
 int solid_mps_bond_intact(const struct solid_mps *s, size_t b);
+
+/* The fracture and contact state as blocks of a state image (mps_ckpt.h),
+ * and back: the counters, and the contact list as built (its pairs, in
+ * their order, and the positions it was built at): a list rebuilt at another
+ * step would sum the same forces in another order. */
+enum mps_status solid_mps_frac_put(const struct solid_mps *s, struct mps_ckpt *c,
+                                   struct mps_err *err);
+enum mps_status solid_mps_frac_get(struct solid_mps *s, struct mps_ckpt *c, struct mps_err *err);
 
 /* Counters for summaries and tests. */
 struct solid_mps_frac_stats {

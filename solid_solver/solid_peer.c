@@ -9,6 +9,7 @@
 #include "mps_host.h"
 #include "mps_json.h"
 #include "mps_prov.h"
+#include "mps_restart.h"
 #include "mps_version.h"
 #include "mps_timer.h"
 #include "proto_solver.h"
@@ -31,6 +32,14 @@ struct peer {
     struct proto_solver_stats stats;
     double wall0;
     int saved_snapshots;   /* snapshots written at the last save (rollback) */
+    struct mps_ckpt rollback; /* the model's state at the last save */
+    /* checkpoints (caps=checkpoint, docs/restart.md) */
+    struct mps_ckpt disk;
+    struct mps_run_mark mark;
+    char *case_yaml;
+    char prefix[64];
+    char restart_path[4400];
+    double restart_time;
 };
 
 static enum mps_status snapshot(struct peer *p, double t, long step, struct mps_err *err)
@@ -67,6 +76,7 @@ static enum mps_status configure(void *self, const char *case_path, const char *
 {
     struct peer *p = self;
     snprintf(p->out, sizeof p->out, "%s", out);
+    snprintf(p->prefix, sizeof p->prefix, "%s", prefix);
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
                                                  mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
@@ -93,12 +103,42 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     p->probes = calloc((size_t)n + 1, sizeof *p->probes);
     if (!p->probes)
         return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
-    char *yaml = mps_case_resolved_yaml(p->cs);
-    st = mps_h5_open(&p->h5, out, prefix, "solid_solver", yaml ? yaml : "", err);
-    free(yaml);
-    if (!st && mps_case_double(p->cs, "output.interval") > 0.0)
+    if (!(p->case_yaml = mps_case_resolved_yaml(p->cs)))
+        return mps_err_set(err, MPS_ENOMEM, "solid: no memory for the resolved case");
+    st = mps_h5_open(&p->h5, out, prefix, "solid_solver", p->case_yaml, err);
+    /* CONFIG restart=N: the snapshots continue from the checkpoint (resume) */
+    if (!st && !p->stats.restart && mps_case_double(p->cs, "output.interval") > 0.0)
         st = snapshot(p, 0.0, 0, err);
     return st;
+}
+
+/* caps=checkpoint (proto_solver.h): the model's state (state_put, the one
+ * rollback keeps) and the snapshot index, as the program alone writes it. */
+static enum mps_status checkpoint(void *self, long number, double time, struct mps_err *err)
+{
+    struct peer *p = self;
+    if (!p->ops->state_put)
+        return mps_err_set(err, MPS_EINPUT, "solid model %s cannot checkpoint", p->ops->name);
+    p->mark.number = number;
+    p->mark.steps = p->substeps;
+    return mps_run_checkpoint(&p->disk, p->out, p->prefix, p->case_yaml, &p->mark, p->h5, time,
+                              p->ops->state_put, p->model, err);
+}
+
+static enum mps_status resume(void *self, long number, struct mps_err *err)
+{
+    struct peer *p = self;
+    enum mps_status st;
+    if (!p->ops->state_get)
+        return mps_err_set(err, MPS_EINPUT, "solid model %s cannot restart", p->ops->name);
+    if ((st = mps_run_read(&p->disk, p->out, p->prefix, number, &p->mark, err)) ||
+        (st = mps_run_get_rest(&p->disk, p->h5, err)) ||
+        (st = p->ops->state_get(p->model, &p->disk, err)))
+        return st;
+    p->substeps = p->mark.steps;
+    p->restart_time = p->disk.time;
+    mps_ckpt_path(p->restart_path, sizeof p->restart_path, p->out, p->prefix, number);
+    return MPS_OK;
 }
 
 static enum mps_status ready(void *self, struct proto_msg *reply, struct mps_err *err)
@@ -152,17 +192,24 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
 static enum mps_status save(void *self, struct mps_err *err)
 {
     struct peer *p = self;
-    if (!p->ops->save)
+    enum mps_status st;
+    if (!p->ops->state_put)
         return mps_err_set(err, MPS_EINPUT, "solid model %s cannot roll back a step",
                            p->ops->name);
+    if (p->ops->rollback_check && (st = p->ops->rollback_check(p->model, err)))
+        return st;
     p->saved_snapshots = mps_h5_count(p->h5);
-    return p->ops->save(p->model, err);
+    mps_ckpt_clear(&p->rollback);
+    return p->ops->state_put(p->model, &p->rollback, err);
 }
 
 static enum mps_status restore(void *self, struct mps_err *err)
 {
     struct peer *p = self;
-    enum mps_status st = p->ops->restore(p->model, err);
+    if (!p->rollback.len)
+        return mps_err_set(err, MPS_EINPUT, "solid: restore without a save");
+    mps_ckpt_rewind(&p->rollback);
+    enum mps_status st = p->ops->state_get(p->model, &p->rollback, err);
     return st ? st : mps_h5_rewind(p->h5, p->saved_snapshots, err);
 }
 
@@ -191,6 +238,15 @@ static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const str
     mps_json_int(&j, "coupling_steps", p->stats.advances - p->stats.repeats);
     mps_json_int(&j, "advances", p->stats.advances); /* repeated iterations included */
     mps_json_num(&j, "rollback_seconds", p->stats.rollback_seconds);
+    mps_json_int(&j, "checkpoints", p->stats.checkpoints - p->stats.restart);
+    mps_json_num(&j, "checkpoint_seconds", p->stats.checkpoint_seconds);
+    mps_json_int(&j, "checkpoint_bytes", (long long)p->disk.len);
+    if (p->restart_path[0]) {
+        mps_json_object(&j, "restart");
+        mps_json_str(&j, "checkpoint", p->restart_path);
+        mps_json_num(&j, "time", p->restart_time);
+        mps_json_close(&j);
+    }
     mps_json_int(&j, "substeps", p->substeps);
     mps_json_num(&j, "substeps_per_coupling_step",
                  p->stats.advances ? (double)p->substeps / p->stats.advances : 0.0);
@@ -231,7 +287,7 @@ int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int 
     /* every model of this program can roll back (a scene that cannot is
      * refused by its save) */
     struct proto_solver_ops pops = {"solid", ops ? ops->name : "case", configure, ready, advance,
-                                    finish, save, restore, 1};
+                                    finish, save, restore, 1, checkpoint, resume};
     struct mps_err err = {0};
     enum mps_status st =
         proto_solver_run(endpoint, &pops, &p, hello_timeout_ms, stop_flag, &p.stats, &err);
@@ -242,5 +298,8 @@ int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int 
         p.ops->destroy(&p.model);
     mps_case_destroy(&p.cs);
     free(p.probes);
+    mps_ckpt_free(&p.rollback);
+    mps_ckpt_free(&p.disk);
+    free(p.case_yaml);
     return mps_status_exit_code(st);
 }

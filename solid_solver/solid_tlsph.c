@@ -1,6 +1,7 @@
 #include "solid_tlsph.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -340,7 +341,6 @@ void solid_tlsph_destroy(struct solid_tlsph **sp)
         return;
     struct solid_tlsph *s = *sp;
     mps_particles_free(&s->ps);
-    mps_particles_ckpt_free(&s->ckpt);
     solid_load_probes_free(&s->loadprobes);
     free(s->pstart);
     free(s->pj);
@@ -737,26 +737,43 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_close(j);
 }
 
-static enum mps_status op_save(void *self, struct mps_err *err)
+/* The state (solid_model_ops.state_put): every particle field, vmax (the
+ * stable step reads it), time, steps and the load probes' means; the pairs
+ * never change. */
+struct tlsph_scalars {
+    double vmax, time;
+    int64_t steps;
+};
+
+static enum mps_status op_state_put(const void *self, struct mps_ckpt *c, struct mps_err *err)
 {
-    struct solid_tlsph *s = self;
-    s->ckpt_vmax = s->vmax;
-    s->ckpt_time = s->time;
-    s->ckpt_steps = s->steps;
-    solid_load_probes_keep(&s->loadprobes, &s->ckpt_loadprobes);
-    return mps_particles_save(&s->ps, &s->ckpt, err);
+    const struct solid_tlsph *s = self;
+    struct tlsph_scalars sc = {s->vmax, s->time, s->steps};
+    struct solid_load_probes_mark m;
+    memset(&m, 0, sizeof m);
+    solid_load_probes_keep(&s->loadprobes, &m);
+    enum mps_status st;
+    if ((st = mps_particles_put(&s->ps, c, err)) ||
+        (st = mps_ckpt_put(c, "tlsph", &sc, sizeof sc, err)))
+        return st;
+    return mps_ckpt_put(c, "load_probes", &m, sizeof m, err);
 }
 
-static enum mps_status op_restore(void *self, struct mps_err *err)
+static enum mps_status op_state_get(void *self, struct mps_ckpt *c, struct mps_err *err)
 {
     struct solid_tlsph *s = self;
-    if (!s->ckpt.nfields)
-        return mps_err_set(err, MPS_EINPUT, "solid: restore without a save");
-    s->vmax = s->ckpt_vmax;
-    s->time = s->ckpt_time;
-    s->steps = s->ckpt_steps;
-    solid_load_probes_back(&s->loadprobes, &s->ckpt_loadprobes);
-    return mps_particles_restore(&s->ps, &s->ckpt, err);
+    struct tlsph_scalars sc;
+    struct solid_load_probes_mark m;
+    enum mps_status st;
+    if ((st = mps_particles_get(&s->ps, c, err)) ||
+        (st = mps_ckpt_get(c, "tlsph", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_get(c, "load_probes", &m, sizeof m, err)))
+        return st;
+    s->vmax = sc.vmax;
+    s->time = sc.time;
+    s->steps = (long)sc.steps;
+    solid_load_probes_back(&s->loadprobes, &m);
+    return MPS_OK;
 }
 
 static void op_destroy(void **self)
@@ -780,6 +797,6 @@ const struct solid_model_ops solid_tlsph_ops = {
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
-    .save = op_save,
-    .restore = op_restore,
+    .state_put = op_state_put,
+    .state_get = op_state_get,
 };

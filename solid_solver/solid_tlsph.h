@@ -142,13 +142,6 @@ struct solid_tlsph {
     double time;
     long steps;
     struct mps_timer timer;
-
-    /* rollback (solid_model_ops.save/restore): every particle field, vmax
-     * (the stable step reads it), time and steps; the pairs never change */
-    struct mps_particles_ckpt ckpt;
-    double ckpt_vmax, ckpt_time;
-    long ckpt_steps;
-    struct solid_load_probes_mark ckpt_loadprobes;
 };
 
 /* Builds particles, pairs, clamps and probes from a scene (copied); alpha and

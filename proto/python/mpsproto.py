@@ -43,6 +43,7 @@ SEND_TIMEOUT_MS = 10000
 F_TEXT = 1
 F_SNAPSHOT = 2
 F_PROBES = 4
+F_CHECKPOINT = 8  # ADVANCE: write a checkpoint after the step (caps=checkpoint)
 
 STATUS_NAMES = ("input", "io", "memory", "library", "solver", "diverged", "protocol",
                 "timeout", "peer", "interrupted")
@@ -51,7 +52,7 @@ STATUS_NAMES = ("input", "io", "memory", "library", "solver", "diverged", "proto
 # ERROR "input: ...". "motion" (value: the case's motion.kind) is sent only
 # when the case's tank moves: a solver that cannot apply the moving frame's
 # body forces (the case's motion block, docs/sloshing.md) refuses it.
-CONFIG_KEYS = ("case", "out", "prefix", "timeout_ms", "rollback", "motion")
+CONFIG_KEYS = ("case", "out", "prefix", "timeout_ms", "rollback", "motion", "restart")
 
 
 class Type(enum.IntEnum):
@@ -144,11 +145,13 @@ def _check(m: Message, dim: int = DIM) -> None:
           Type.RESULT: m.payload != Payload.NONE}.get(Type(t), m.payload == Payload.NONE)
     if not ok:
         _fail(m, f"payload {Payload(m.payload).name} not allowed")
-    known = F_TEXT | F_SNAPSHOT | F_PROBES
+    known = F_TEXT | F_SNAPSHOT | F_PROBES | F_CHECKPOINT
     if m.flags & ~known:
         _fail(m, f"flags {m.flags:#x} have unknown bits {m.flags & ~known:#x}")
     if m.flags & F_SNAPSHOT and t != Type.ADVANCE:
         _fail(m, "flag SNAPSHOT is for ADVANCE only")
+    if m.flags & F_CHECKPOINT and t != Type.ADVANCE:
+        _fail(m, "flag CHECKPOINT is for ADVANCE only")
     if m.flags & F_PROBES and t not in (Type.ADVANCE, Type.RESULT):
         _fail(m, "flag PROBES is for ADVANCE and RESULT only")
     if bool(m.flags & F_TEXT) != (m.text is not None):

@@ -25,6 +25,13 @@ in CONFIG it keeps (q, q') and the number of snapshots at the start of every
 step and returns to them when the coupler repeats the step (a repeated
 snapshot is written again under the same name and listed once in the index).
 
+Checkpoints (PROTOCOL.md 6, docs/restart.md): it declares caps=checkpoint;
+after an ADVANCE with CHECKPOINT it writes OUT/checkpoint/PREFIX_NNNNNN.ckpt
+(its own format: JSON with q, q', the step count and the snapshot index, the
+floats as hex so they read back bit for bit; written to a temporary file and
+renamed; the last two kept), NNNNNN counting the checkpoints from CONFIG
+restart=N (or 0); with restart=N in CONFIG it starts from checkpoint N.
+
 usage: modal_beam_solid.py [--courant C] [--key FILE] --connect ENDPOINT
 """
 import json, math, os, sys, time
@@ -161,6 +168,10 @@ class Snapshots:
                      'Center="Node">\n' + item(fname, f'{n} 3' if vec else f'{n}', num) +
                      '    </Attribute>\n')
         self.grids.append(grid + '   </Grid>\n')
+        self.index()
+
+    def index(self):
+        """Rewrites OUT/PREFIX.xmf from the grids (after a snapshot, a restart)."""
         index = os.path.join(self.out, self.prefix + '.xmf')
         try:
             with open(index + '.tmp', 'w') as f:
@@ -171,6 +182,46 @@ class Snapshots:
             os.replace(index + '.tmp', index)
         except OSError as e:
             raise Fail('io', f'cannot write {index}: {e}') from e
+
+
+class Checkpoints:
+    """OUT/checkpoint/PREFIX_NNNNNN.ckpt: the beam's whole state (q, q') with
+    the step count and the snapshot index (the series continues from it)."""
+
+    def __init__(self, out, prefix):
+        self.dir, self.prefix = os.path.join(out, 'checkpoint'), prefix
+
+    def path(self, number):
+        return os.path.join(self.dir, f'{self.prefix}_{number:06d}.ckpt')
+
+    def write(self, number, t, beam, step, grids):
+        state = {'number': number, 'time': float(t).hex(), 'q': float(beam.q).hex(),
+                 'qd': float(beam.qd).hex(), 'step': step, 'grids': grids}
+        path = self.path(number)
+        try:
+            os.makedirs(self.dir, exist_ok=True)
+            with open(path + '.tmp', 'w') as f:
+                json.dump(state, f)
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(path + '.tmp', path)  # a kill while writing leaves the last ones
+            for name in os.listdir(self.dir):  # keep this one and the one before
+                if name.startswith(self.prefix + '_') and name.endswith('.ckpt'):
+                    k = name[len(self.prefix) + 1:-5]
+                    if k.isdigit() and (int(k) <= number - 2 or int(k) > number):
+                        os.remove(os.path.join(self.dir, name))
+        except OSError as e:
+            raise Fail('io', f'cannot write {path}: {e}') from e
+
+    def read(self, number, beam):
+        path = self.path(number)
+        try:
+            with open(path) as f:
+                state = json.load(f)
+            beam.q, beam.qd = float.fromhex(state['q']), float.fromhex(state['qd'])
+            return int(state['step']), list(state['grids'])
+        except (OSError, KeyError, TypeError, ValueError) as e:
+            raise Fail('input', f'CONFIG restart={number}: cannot read {path}: {e}') from e
 
 
 def converse(sock, courant, t_wall):
@@ -204,7 +255,16 @@ def converse(sock, courant, t_wall):
     roll = mp.Rollback(conf.get('rollback') == 'on')
     step = 0
     snaps = Snapshots(conf['out'], conf['prefix'], config_text)
-    snaps.write(0, 0.0, beam)
+    ckpts = Checkpoints(conf['out'], conf['prefix'])
+    number = conf.get('restart', '0')
+    if not number.isdigit() or (number != '0' and int(number) < 1):
+        raise Fail('input', f'CONFIG restart={number}: must be a checkpoint number >= 1')
+    number = int(number)
+    if number:  # the state and the snapshot series of checkpoint N
+        step, snaps.grids = ckpts.read(number, beam)
+        snaps.index()
+    else:
+        snaps.write(0, 0.0, beam)
     kept = (beam.q, beam.qd, len(snaps.grids))   # the state a repeated step starts from
 
     def state_msg(mtype, **kw):
@@ -246,6 +306,9 @@ def converse(sock, courant, t_wall):
         step += 1
         if m.flags & mp.F_SNAPSHOT:
             snaps.write(m.step + 1, m.time + m.dt, beam)
+        if m.flags & mp.F_CHECKPOINT:
+            number += m.iteration == 0  # a repeated iteration rewrites the step's
+            ckpts.write(number, m.time + m.dt, beam, step, snaps.grids)
         kw = {}
         if m.flags & mp.F_PROBES:
             kw = dict(flags=mp.F_PROBES, probes=np.array([beam.q]))
@@ -267,7 +330,8 @@ def main():
         ctx.term()
         return 2
     mp.send(sock, mp.Message(mp.Type.HELLO,
-                             text=f'role=solid model=modal_beam pid={os.getpid()} caps=rollback'))
+                             text=f'role=solid model=modal_beam pid={os.getpid()} '
+                                  'caps=rollback,checkpoint'))
     try:
         code = converse(sock, courant, time.time())
     except (Fail, mp.ProtocolError, TimeoutError) as e:

@@ -31,6 +31,12 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
                   with loads A (must give iteration 0's RESULT bit for bit: the state of the
                   step's start was restored), step 1 with A twice (the same), then an
                   iteration out of order: ERROR "protocol: ...", exit 1
+  checkpoint      only for a solid that declares caps=checkpoint: step 0 (loads A), step 1
+                  (loads A, CHECKPOINT), step 2 (loads B, PROBES), STOP; then a second
+                  process with CONFIG restart=1 in the same out directory: its READY must
+                  be step 1's RESULT state bit for bit and its step 2 with loads B step 2's
+                  RESULT bit for bit (section 6, "Checkpoints"); a third with restart=9
+                  (never written): ERROR "input: ...", exit 2
   curve           on tcp with CURVE (section 10): the key file reaches the solver
                   as the coupler passes it (MPS_COUPLING_KEY); HELLO, READY, one
                   ADVANCE, STOP/BYE, exit 0, authenticated with the issued key
@@ -919,6 +925,61 @@ class Suite:
                           time=dt, dt=dt, n_sub=n))
         self.expect_error(s, 'rollback.out_of_order', 'protocol', 1)
 
+    def scenario_checkpoint(self, s):
+        """Section 6, checkpoints: a solver restarted from checkpoint N goes on
+        exactly as the solver that wrote it."""
+        text = self.hello(s)
+        if 'checkpoint' not in mp.capabilities(text):
+            print(f'INFO  checkpoint: the solid declares no caps=checkpoint ({text!r}): a run '
+                  'that asks for checkpoints or restarts refuses it; not checked')
+            return
+        r = self.ready(s)
+        free = (r.surface == 1) & (r.fixed == 0)
+        ids = r.id[free]
+        a = (ids, np.tile([self.args.force, 0.0], (len(ids), 1)))
+        b = (ids, np.tile([-3.0 * self.args.force, 0.0], (len(ids), 1)))
+        dt, n = self.args.dt, self.n_sub(r.dt)
+        self.advance(s, 0, 0.0, dt, n, mp.Payload.LOADS, a)
+        f1, m1 = self.advance(s, 1, dt, dt, n, mp.Payload.LOADS, a, mp.F_CHECKPOINT)
+        f2, m2 = self.advance(s, 2, 2 * dt, dt, n, mp.Payload.LOADS, b, mp.F_PROBES)
+        s.send(mp.Message(mp.Type.STOP, step=3, time=3 * dt))
+        bye, _ = s.recv(EXIT_DEADLINE)
+        rc = s.wait_exit(EXIT_DEADLINE)
+        self.check('checkpoint.run', bye is not None and rc == 0,
+                   f'steps 0-2 (CHECKPOINT on step 1), BYE, exit {rc}')
+        s2 = Session(self, 'checkpoint_restart')
+        s2.out = s.out  # where the first process wrote its checkpoint
+        try:
+            self.hello(s2)
+            m = self.ready(s2, 'restart=1\n')
+            d = [k for k in ('x', 'v', 'id', 'surface', 'fixed')
+                 if getattr(m, k).tobytes() != getattr(m1, k).tobytes()]
+            self.check('checkpoint.ready', not d and m.dt == m1.dt,
+                       'READY after CONFIG restart=1: the state and stable step of step 1\'s '
+                       'RESULT bit for bit' if not d and m.dt == m1.dt else
+                       f'differs from step 1\'s RESULT in {", ".join(d) or "dt"}')
+            g2, n2 = self.advance(s2, 2, 2 * dt, dt, n, mp.Payload.LOADS, b, mp.F_PROBES)
+            d = [k for k in ('x', 'v', 'id', 'surface', 'fixed', 'probes')
+                 if np.asarray(getattr(m2, k)).tobytes() != np.asarray(getattr(n2, k)).tobytes()]
+            d += [k for k in ('time', 'dt', 'nprobes') if f2[k] != g2[k]]
+            self.check('checkpoint.continue', not d,
+                       'step 2 after the restart: the RESULT of the uninterrupted run bit for bit'
+                       if not d else f'differs in {", ".join(d)}')
+        except Stop:
+            pass
+        finally:
+            s2.close()
+        s3 = Session(self, 'checkpoint_missing')
+        s3.out = s.out
+        try:
+            self.hello(s3)
+            s3.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s3, 'restart=9\n')))
+            self.expect_error(s3, 'checkpoint.missing', 'input', 2)
+        except Stop:
+            pass
+        finally:
+            s3.close()
+
     def scenario_curve(self, s):
         """Section 10: a whole short conversation over tcp with CURVE."""
         self.hello(s)
@@ -949,7 +1010,7 @@ class Suite:
 
     SCENARIOS = ('run', 'abort', 'reject', 'bad_magic', 'truncated', 'wrong_version',
                  'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'motion', 'timeout',
-                 'iteration_unasked', 'rollback', 'curve', 'curve_no_key')
+                 'iteration_unasked', 'rollback', 'checkpoint', 'curve', 'curve_no_key')
 
     def run(self):
         print(f'conformance: solid {" ".join(self.command)}, case {self.args.case}', flush=True)

@@ -1,0 +1,51 @@
+# Checkpoint and restart (docs/restart.md, issue 19): a run to T against the
+# same run stopped at its checkpoint after STOP and restarted from the one at
+# HALF (so the rows and snapshots between HALF and STOP are rewritten, not
+# repeated). Every probes.csv row, every field of every snapshot and the XDMF
+# index must be bit-identical (tests/common/restart_check.py). Coarse and
+# short: a few seconds each.
+set(RS_CHECK /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/restart_check.py)
+set(RS_OUT ${CMAKE_BINARY_DIR}/test_out/restart)
+
+# the fluid alone: dam break at dp = 10 mm to 0.3 s (the front is at the far
+# wall by 0.25 s), checkpoints every 0.075 s
+add_test(NAME restart_fluid_dambreak
+  COMMAND ${RS_CHECK} ${RS_OUT}/fluid 0.15 0.2 $<TARGET_FILE:fluid_solver>
+          cases/dambreak/case.yml --set dp=0.01 --set end_time=0.3 --set output.interval=0.05
+          --set output.checkpoint_interval=0.075
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# the solid alone: the fracture collision at dp = 25 mm to 0.4 s, restarted
+# at 0.2 s with 3 bonds broken and the bodies in contact (--require)
+add_test(NAME restart_solid_fracture
+  COMMAND ${RS_CHECK} ${RS_OUT}/solid 0.2 0.3 $<TARGET_FILE:solid_solver>
+          cases/fracture_collision/case.yml --set dp=0.025 --set end_time=0.4
+          --set output.interval=0.05 --set output.checkpoint_interval=0.1
+          --require broken_bonds
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_fluid_dambreak restart_solid_fracture PROPERTIES
+  TIMEOUT 60 LABELS integration)
+# coupled (explicit scheme): the dam break on the elastic plate at 6 mm to
+# 0.2 s (the water reaches the plate at about 0.12 s), checkpoints every
+# 0.05 s; every process restarts from its own checkpoint of the same number
+add_test(NAME restart_coupled_plate
+  COMMAND ${RS_CHECK} ${RS_OUT}/plate 0.1 0.15 $<TARGET_FILE:coupler>
+          cases/dambreak_elastic_plate/case.yml --set dp=0.006 --set end_time=0.2
+          --set output.interval=0.05 --set output.checkpoint_interval=0.05
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# the same run with the coupler killed (SIGKILL) once a checkpoint at or
+# after 0.1 s exists: both solvers must exit by themselves within 10 s (they
+# do in about 0.1 s), and a plain --restart must finish the run bit for bit
+add_test(NAME restart_coupled_plate_kill
+  COMMAND ${RS_CHECK} ${RS_OUT}/plate_kill 0.1 kill $<TARGET_FILE:coupler>
+          cases/dambreak_elastic_plate/case.yml --set dp=0.006 --set end_time=0.2
+          --set output.interval=0.05 --set output.checkpoint_interval=0.05
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# coupled with the TLSPH solid: the elastic gate at 2.5 mm to 0.08 s
+add_test(NAME restart_coupled_gate_tlsph
+  COMMAND ${RS_CHECK} ${RS_OUT}/gate 0.04 0.06 $<TARGET_FILE:coupler>
+          cases/elastic_gate/case.yml --set dp=0.0025 --set end_time=0.08
+          --set output.interval=0.02 --set output.checkpoint_interval=0.02
+          --solid "solid_solver --model tlsph"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_coupled_plate restart_coupled_plate_kill restart_coupled_gate_tlsph
+  PROPERTIES TIMEOUT 120 LABELS integration)
