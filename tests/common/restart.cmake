@@ -49,3 +49,12 @@ add_test(NAME restart_coupled_gate_tlsph
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(restart_coupled_plate restart_coupled_plate_kill restart_coupled_gate_tlsph
   PROPERTIES TIMEOUT 120 LABELS integration)
+# coupled with the Python modal solid (its own checkpoint format): the plate in
+# water of the coupler tests to 0.2 s, restarted at 0.1 s
+add_test(NAME restart_coupled_python_solid
+  COMMAND ${RS_CHECK} ${RS_OUT}/python 0.1 0.15 $<TARGET_FILE:coupler>
+          tests/coupler/plate_in_water.yml --set end_time=0.2 --set output.interval=0.05
+          --set output.checkpoint_interval=0.05
+          --solid "/usr/bin/python3 solid_solver/python/modal_beam_solid.py"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_coupled_python_solid PROPERTIES TIMEOUT 120 LABELS integration)

@@ -10,7 +10,8 @@ is one near HALF before it), then PROGRAM --restart OUT/cut --from HALF: the
 rows of probes.csv between HALF and STOP must be replaced, not repeated.
 With --kill instead of STOP ("kill"), the cut run is killed with SIGKILL as
 soon as a checkpoint at or after HALF exists, and restarted from its latest.
-Then every data row of probes.csv, every snapshot's particle fields and
+A third run without checkpoints (output.checkpoint_interval=0) must give
+the same probes.csv rows as the first. Then every data row of probes.csv, every snapshot's particle fields and
 time/step attributes, and the XDMF indexes must be identical between
 OUT/full and OUT/cut; the restart's summary.json must say where it restarted.
 --require COLUMN: the column must be > 0 at the checkpoint restarted from
@@ -132,6 +133,11 @@ def main():
             fail("--stop-at %s did not stop the run (%d rows)" % (stop, cut_rows))
         run([prog, "--restart", cut, "--from", str(half), "--quiet"])
 
+    # checkpoints must not change the run: the same without them
+    nock = os.path.join(out, "nock")
+    run([prog, case, "--out", nock, "--quiet"] + extra + ["--set", "output.checkpoint_interval=0"])
+    if rows(os.path.join(full, "probes.csv")) != rows(os.path.join(nock, "probes.csv")):
+        fail("probes.csv differs between the run with checkpoints and the run without")
     ra, rb = rows(os.path.join(full, "probes.csv")), rows(os.path.join(cut, "probes.csv"))
     if ra != rb:
         n = next((k for k, (x, y) in enumerate(zip(ra, rb)) if x != y), min(len(ra), len(rb)))
