@@ -61,3 +61,30 @@ add_test(NAME restart_coupled_python_solid
 set_tests_properties(restart_coupled_python_solid PROPERTIES TIMEOUT 120 LABELS integration)
 
 mps_add_test(test_ckpt SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ckpt.c LABELS unit TIMEOUT 30)
+
+# Bad restarts: one clear line, exit 2 (tests/expect_fail.sh)
+set(RS_FAIL sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh)
+function(restart_bad name pattern)
+  add_test(NAME restart_bad_${name} COMMAND ${RS_FAIL} "${pattern}" ${ARGN}
+           WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(restart_bad_${name} PROPERTIES TIMEOUT 30 LABELS integration)
+endfunction()
+restart_bad(no_checkpoint "no checkpoints" $<TARGET_FILE:fluid_solver>
+            --restart ${RS_OUT}/no_such_run)
+restart_bad(case_file "takes no case file" $<TARGET_FILE:solid_solver>
+            --restart ${RS_OUT}/solid/cut cases/fracture_collision/case.yml)
+restart_bad(set_other "a restart takes only --set end_time" $<TARGET_FILE:coupler>
+            --restart ${RS_OUT}/plate/cut --set dp=0.01)
+restart_bad(from_alone "--from needs --restart" $<TARGET_FILE:fluid_solver>
+            cases/dambreak/case.yml --out ${RS_OUT}/bad --from 0.1)
+restart_bad(implicit "implicit coupling are not implemented" $<TARGET_FILE:coupler>
+            tests/coupler/plate_in_water.yml --out ${RS_OUT}/bad --set coupling.scheme=implicit
+            --set output.checkpoint_interval=0.1)
+# a solid without caps=checkpoint is refused when the case asks for checkpoints
+# (its own and the fluid's lines follow the coupler's: grep, not expect_fail)
+add_test(NAME restart_refuses_solid_without_checkpoint
+  COMMAND sh -c "\"$0\" tests/coupler/plate_in_water.yml --out \"$1\" --quiet --solid fake_solid --set output.checkpoint_interval=0.1 2>\"$1.err\"; rc=$?; test $rc -eq 2 && grep -q '^coupler: input: .*this solid solver cannot checkpoint (its HELLO declares no caps=checkpoint)' \"$1.err\""
+          $<TARGET_FILE:coupler> ${RS_OUT}/nockpt
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_refuses_solid_without_checkpoint PROPERTIES TIMEOUT 60
+  LABELS integration)
