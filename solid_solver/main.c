@@ -71,14 +71,7 @@ static enum mps_status write_checkpoint(struct run *r, const char *dir, const ch
 
 static enum mps_status write_snapshot(struct run *r, double t, long step, struct mps_err *err)
 {
-    double w0 = mps_wall_seconds();
-    const double(*x)[MPS_DIM] = NULL;
-    struct mps_field f[MAX_FIELDS];
-    int nf = 0;
-    size_t n = r->ops->snapshot(r->model, &x, f, MAX_FIELDS, &nf);
-    enum mps_status st = mps_h5_write(r->h5, t, step, n, x, f, nf, err);
-    r->t_output += mps_wall_seconds() - w0;
-    return st;
+    return solid_model_snapshot(r->ops, r->model, r->h5, t, step, &r->t_output, err);
 }
 
 static enum mps_status write_probes(struct run *r, double t, struct mps_err *err)

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "mps_timer.h"
 #include "solid_mps.h"
 #include "solid_tlsph.h"
 
@@ -26,4 +27,18 @@ const char *solid_model_names(void)
             snprintf(names + strlen(names), sizeof names - strlen(names), "%s%s", k ? ", " : "",
                      models[k]->name);
     return names;
+}
+
+enum mps_status solid_model_snapshot(const struct solid_model_ops *ops, void *model,
+                                     struct mps_h5_series *h5, double t, long step,
+                                     double *seconds, struct mps_err *err)
+{
+    double w0 = mps_wall_seconds();
+    const double(*x)[MPS_DIM] = NULL;
+    struct mps_field f[MPS_PARTICLES_MAX_FIELDS];
+    int nf = 0;
+    size_t n = ops->snapshot(model, &x, f, MPS_PARTICLES_MAX_FIELDS, &nf);
+    enum mps_status st = mps_h5_write(h5, t, step, n, x, f, nf, err);
+    *seconds += mps_wall_seconds() - w0;
+    return st;
 }

@@ -92,6 +92,13 @@ struct solid_model_ops {
     enum mps_status (*rollback_check)(const void *self, struct mps_err *err);
 };
 
+/* Writes the model's snapshot at time t, step into the series (the one
+ * snapshot writer of the solid program alone and under the coupler); adds
+ * the wall seconds it took to *seconds. */
+enum mps_status solid_model_snapshot(const struct solid_model_ops *ops, void *model,
+                                     struct mps_h5_series *h5, double t, long step,
+                                     double *seconds, struct mps_err *err);
+
 /* The models compiled in, by name; NULL if unknown. */
 const struct solid_model_ops *solid_model_find(const char *name);
 /* "mps, tlsph": for error messages. */

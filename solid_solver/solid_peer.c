@@ -15,8 +15,6 @@
 #include "proto_solver.h"
 #include "solid_scene.h"
 
-#define MAX_FIELDS 24
-
 struct peer {
     const struct solid_model_ops *ops;
     void *model;
@@ -44,14 +42,7 @@ struct peer {
 
 static enum mps_status snapshot(struct peer *p, double t, long step, struct mps_err *err)
 {
-    double w0 = mps_wall_seconds();
-    const double(*x)[MPS_DIM] = NULL;
-    struct mps_field f[MAX_FIELDS];
-    int nf = 0;
-    size_t n = p->ops->snapshot(p->model, &x, f, MAX_FIELDS, &nf);
-    enum mps_status st = mps_h5_write(p->h5, t, step, n, x, f, nf, err);
-    p->t_output += mps_wall_seconds() - w0;
-    return st;
+    return solid_model_snapshot(p->ops, p->model, p->h5, t, step, &p->t_output, err);
 }
 
 static enum mps_status state(struct peer *p, struct proto_msg *m, struct mps_err *err)
