@@ -290,9 +290,9 @@ int main(int argc, char **argv)
     /* a rigid plate fixed in the tank: it has no body forces to move
      * (moving_frame 0) */
     static const struct proto_solver_ops ops = {"solid", "fake", configure, ready,
-                                                advance, finish,  save,      restore, 0};
-    static const struct proto_solver_ops ops_fixed = {"solid", "fake", configure,
-                                                      ready,   advance, finish, NULL, NULL, 0};
+                                                advance, finish,  save,      restore, 0, NULL};
+    static const struct proto_solver_ops ops_fixed = {"solid", "fake", configure, ready, advance,
+                                                      finish,  NULL,   NULL,      0,     NULL};
     enum mps_status st = proto_solver_run(endpoint, rollback ? &ops : &ops_fixed, &s, hello_ms,
                                           &stop_flag, &stats, &err);
     if (st)
