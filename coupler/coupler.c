@@ -980,7 +980,7 @@ static void cleanup(struct coupler *c)
     proto_msg_clear(&c->loads);
     coupling_iter_free(&c->iter);
     coupling_accel_destroy(&c->accel);
-    if (c->iter_log)
+    if (c->iter_log) /* closed by finish_run; here only when the run never got there */
         fclose(c->iter_log);
     mps_probes_close(&c->probes);
     mps_motion_destroy(&c->motion);
@@ -1200,6 +1200,18 @@ static enum mps_status finish_run(struct coupler *c, enum mps_status st, struct 
                     guard_refused(c->guard), guard_refused(c->guard) == 1 ? "" : "s", who);
     }
     struct mps_err werr;
+    /* iterations.csv is part of the record: a write lost on close is said */
+    if (c->iter_log) {
+        int bad = ferror(c->iter_log);
+        bad |= fclose(c->iter_log) != 0;
+        c->iter_log = NULL;
+        if (bad) {
+            fprintf(stderr, "coupler: %s%s/iterations.csv: cannot write: %s\n",
+                    st ? "also: " : "io: ", c->out, strerror(errno));
+            if (!st)
+                st = mps_err_set(err, MPS_EIO, "%s/iterations.csv: cannot write", c->out);
+        }
+    }
     if (write_summary(c, st, err, &werr)) {
         /* a failed run keeps its own status; a finished one fails here, since
          * its record is incomplete */
