@@ -20,12 +20,8 @@ import h5py
 import numpy as np
 import yaml
 
+from probes_csv import probes_table
 
-
-def csv_rows(path):
-    """The lines of a CSV but its '#' provenance header (probes.csv)."""
-    with open(path) as f:
-        return [line for line in f if not line.startswith('#')]
 
 def snapshots(run, prefix):
     out = {}
@@ -41,7 +37,7 @@ def nearest(snaps, t):
 
 
 def angle_at(run, t):
-    d = np.genfromtxt(csv_rows(os.path.join(run, 'probes.csv')), delimiter=',', names=True)
+    d = probes_table(os.path.join(run, 'probes.csv'))
     return float(np.interp(t, d['time'], d['tank_angle']))
 
 

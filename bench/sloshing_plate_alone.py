@@ -22,19 +22,14 @@ import os
 import subprocess
 import sys
 
-import numpy as np
+
+from probes_csv import probes_table
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SOLID = os.path.join(ROOT, 'build', 'bin', 'solid_solver')
 E, NU, RHO, T, A = 6.0e6, 0.49, 1100.0, 0.004, 0.981
 CASES = {'low': 0.0574, 'high': 0.1148}
 
-
-
-def csv_rows(path):
-    """The lines of a CSV but its '#' provenance header (probes.csv)."""
-    with open(path) as f:
-        return [line for line in f if not line.startswith('#')]
 
 def theory(L, plane):
     Ep = E if plane == 'stress' else E / (1.0 - NU * NU)
@@ -50,7 +45,7 @@ def free_length(H, dp):
 
 
 def measure(path):
-    d = np.genfromtxt(csv_rows(path), delimiter=',', names=True)
+    d = probes_table(path)
     t, x = d['time'], d['tip_dx']
     m = x.mean()
     s = x - m

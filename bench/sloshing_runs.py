@@ -34,6 +34,8 @@ import time
 
 import numpy as np
 
+from probes_csv import probes_table
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 COUPLER = os.path.join(ROOT, 'build', 'bin', 'coupler')
 
@@ -53,15 +55,9 @@ COARSE = ['fluid.tank.width=0.610', 'fluid.blocks.1.x1=0.610', 'motion.pivot.x=0
 TLSPH = 'solid_solver --model tlsph'
 
 
-
-def csv_rows(path):
-    """The lines of a CSV but its '#' provenance header (probes.csv)."""
-    with open(path) as f:
-        return [line for line in f if not line.startswith('#')]
-
 def probes(path):
     """probes.csv as a structured array, one row or many (a 1-row file is 1-D too)."""
-    return np.atleast_1d(np.genfromtxt(csv_rows(path), delimiter=',', names=True))
+    return probes_table(path)
 
 
 def run_list():

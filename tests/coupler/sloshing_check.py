@@ -29,12 +29,9 @@ import sys
 import numpy as np
 import yaml
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
+from probes_csv import probes_table  # noqa: E402
 
-
-def csv_rows(path):
-    """The lines of a CSV but its '#' provenance header (probes.csv)."""
-    with open(path) as f:
-        return [line for line in f if not line.startswith('#')]
 
 def main():
     ap = argparse.ArgumentParser()
@@ -49,7 +46,7 @@ def main():
     case = yaml.safe_load(open(os.path.join(a.run, 'case_resolved.yml')))
     if summ.get('status') != 'ok' or summ.get('simulated_time', 0) < a.t_end - 1e-9:
         bad.append(f"run did not finish: {summ.get('status')}: {summ.get('message')}")
-    d = np.genfromtxt(csv_rows(os.path.join(a.run, 'probes.csv')), delimiter=',', names=True)
+    d = probes_table(os.path.join(a.run, 'probes.csv'))
     print(f"fluid: lost {fl.get('lost_particles')}, tank guard uses {fl.get('wall_guard_uses')}, "
           f"escaped at most {d['escaped'].max():.0f}")
     if fl.get('lost_particles') or fl.get('wall_guard_uses') or d['escaped'].max() > 0:

@@ -28,12 +28,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
+from probes_csv import probes_table  # noqa: E402
 
-
-def csv_rows(path):
-    """The lines of a CSV but its '#' provenance header (probes.csv)."""
-    with open(path) as f:
-        return [line for line in f if not line.startswith('#')]
 
 def fit(t, s, T0):
     """Least-squares damped sinusoid plus constant; returns (T, gamma, A, c, rms)."""
@@ -77,7 +74,7 @@ def main():
     if summ.get('wall_guard_uses', 0) or summ.get('lost_particles', 0):
         bad.append(f"tank guard uses {summ.get('wall_guard_uses')}, lost "
                    f"{summ.get('lost_particles')}")
-    d = np.genfromtxt(csv_rows(os.path.join(a.run, 'probes.csv')), delimiter=',', names=True)
+    d = probes_table(os.path.join(a.run, 'probes.csv'))
     if d['escaped'].max() if 'escaped' in d.dtype.names else 0:
         bad.append('particles escaped the tank')
     L, H = a.length, a.depth

@@ -29,12 +29,9 @@ import sys
 import h5py
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
+from probes_csv import probes_table  # noqa: E402
 
-
-def csv_rows(path):
-    """The lines of a CSV but its '#' provenance header (probes.csv)."""
-    with open(path) as f:
-        return [line for line in f if not line.startswith('#')]
 
 def main():
     ap = argparse.ArgumentParser()
@@ -86,7 +83,7 @@ def main():
     if not abs(slope) < lim:
         bad.append('the surface is not level in the lab frame')
     # probes in the tank frame
-    d = np.genfromtxt(csv_rows(os.path.join(a.run, 'probes.csv')), delimiter=',', names=True)
+    d = probes_table(os.path.join(a.run, 'probes.csv'))
     dl = d['level_left'][-1] - d['level_right'][-1]
     want = (a.width - dp) * math.tan(th)
     print(f'level_left - level_right (tank frame) {dl * 1e3:.2f} mm, expected (W - dp) tan = '
