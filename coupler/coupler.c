@@ -1174,7 +1174,14 @@ static enum mps_status finish_run(struct coupler *c, enum mps_status st, struct 
         /* one line, as for the coupler's own keys; the solvers are stopped
          * without a word (they print nothing on ABORT) */
         fprintf(stderr, "coupler: %s\n", err->msg);
-        abort_all(c, err->msg, -1);
+        /* a solver whose handshake has not begun (the fluid, when the solid
+         * found the problem) has nothing to flush, and may not be connected
+         * yet to read ABORT: SIGTERM at once, not after the grace */
+        int idle = -1;
+        for (int k = 0; k < NPEERS; k++)
+            if (c->p[k].active && !c->p[k].engaged)
+                idle = k;
+        abort_all(c, err->msg, idle);
     } else if (st) {
         fprintf(stderr, "\ncoupler: %s: %s\n", mps_status_name(st), err->msg);
         int hung = -1; /* the solver that missed a deadline, if that was the failure */

@@ -285,6 +285,10 @@ fail:
     if (sock && !said_error && st != MPS_EPEER && send_error(sock, &in, st, err) == MPS_OK &&
         st == MPS_EINPUT && strncmp(err->msg, PROTO_CASE_ERROR, strlen(PROTO_CASE_ERROR)) == 0)
         stats->coupler_reports = 1; /* the coupler prints it as its own */
+    /* stopped by a signal before CONFIG: it has done nothing, and the run's
+     * end (the other solver's error, Ctrl-C) is the coupler's to tell */
+    if (st == MPS_EINTR && !configured)
+        stats->coupler_reports = 1;
 done:
     if (configured) {
         char *json = ops->finish(self, st, err);

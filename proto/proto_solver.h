@@ -58,10 +58,10 @@ struct proto_solver_stats {
     long advances;            /* every ADVANCE, repeated iterations included */
     long repeats;             /* ADVANCEs with iteration > 0 */
     int rollback;             /* CONFIG asked for rollback=on */
-    /* 1: the run ended with ABORT, or with a case error sent to the coupler
-     * (proto_solver_case_error): the coupler tells the user why, on its own
-     * terminal, so the solver program prints nothing (a case error is then
-     * one line, as the coupler's own are) */
+    /* 1: the run ended with ABORT, with a case error sent to the coupler
+     * (proto_solver_case_error), or with a signal before CONFIG: the coupler
+     * tells the user why, on its own terminal, so the solver program prints
+     * nothing (a case error is then one line, as the coupler's own are) */
     int coupler_reports;
 };
 
