@@ -27,3 +27,8 @@ keys_expect_fail(coupler_python_key_line
 keys_expect_fail(coupler_mps_refuses_python_key
   "^coupler: --set solid.modal_beam.courant=0.5: solid.modal_beam.courant = 0.5: unknown key$"
   tests/coupler/plate_in_water.yml --set solid.modal_beam.courant=0.5)
+# Implicit coupling with fracture: the solid refuses rollback=on as a problem
+# of the case's keys (it used to be the coupler's check, with this message).
+keys_expect_fail(coupler_implicit_fracture
+  "^coupler: --set coupling.scheme=implicit: coupling.scheme = implicit: implicit coupling cannot be used with fracture or contact \\(solid.eps_max, solid.contact\\): the interface would change within a step$"
+  tests/coupler/plate_in_water.yml --set solid.eps_max=0.1 --set coupling.scheme=implicit)
