@@ -258,6 +258,7 @@ void mps_case_destroy(struct mps_case **cp)
     free(c->ignore);
     free(c->pool);
     free(c->path);
+    free(c->origin);
     free(c->dir);
     free(c);
     *cp = NULL;
@@ -414,7 +415,7 @@ const char *mps_case_where(const struct mps_case *c, const char *key)
     if (s && s->def)
         return "default";
     e = find_section(c, key);
-    return e ? e->where : c->path;
+    return e ? e->where : mps_case_origin(c);
 }
 
 enum mps_status mps_case_fail(const struct mps_case *c, struct mps_err *err, const char *key,
@@ -436,6 +437,11 @@ enum mps_status mps_case_fail(const struct mps_case *c, struct mps_err *err, con
     if (err)
         case_one_line(err->msg);
     return MPS_EINPUT;
+}
+
+const char *mps_case_origin(const struct mps_case *c)
+{
+    return c->origin ? c->origin : c->path;
 }
 
 const char *mps_case_path(const struct mps_case *c)

@@ -99,6 +99,10 @@ enum mps_status mps_case_fail(const struct mps_case *c, struct mps_err *err, con
 
 /* Path of the case file as given, and its directory (for relative paths). */
 const char *mps_case_path(const struct mps_case *c);
+/* The file to name in a message about the case as a whole or a key it lacks:
+ * for a resolved copy (mps_case_write_resolved), the user's case it was
+ * resolved from, as the coupler named it; else mps_case_path. */
+const char *mps_case_origin(const struct mps_case *c);
 const char *mps_case_dir(const struct mps_case *c);
 
 /* The resolved configuration (every declared key with its value, defaults

@@ -231,12 +231,13 @@ static int check_required(struct mps_case *c, const struct mps_key_spec *s, cons
     if (case_find_entry(c, key))
         return 0;
     const char *help = s->help ? s->help : "", *units = s->units ? s->units : "";
+    const char *file = mps_case_origin(c);
     if (*help && *units)
-        case_add_err(es, "%s: missing required key '%s' (%s, %s)", c->path, key, help, units);
+        case_add_err(es, "%s: missing required key '%s' (%s, %s)", file, key, help, units);
     else if (*help || *units)
-        case_add_err(es, "%s: missing required key '%s' (%s)", c->path, key, *help ? help : units);
+        case_add_err(es, "%s: missing required key '%s' (%s)", file, key, *help ? help : units);
     else
-        case_add_err(es, "%s: missing required key '%s'", c->path, key);
+        case_add_err(es, "%s: missing required key '%s'", file, key);
     return 0;
 }
 

@@ -36,6 +36,7 @@ struct entry {
 
 struct mps_case {
     char *path, *dir;
+    char *origin; /* a resolved copy's user case (mps_case_origin); NULL: path */
     struct entry *e;
     int n, cap;
     /* Copies of the spec tables and ignore prefixes (strings in pool), so the
@@ -109,9 +110,11 @@ void case_suggest(const struct mps_case *c, const char *key, char *out, size_t n
  * key came from and its value there ("#@ fluid.rho<TAB>case.yml:14<TAB>1000";
  * the origin is also "--set dp=0.01" or "default"). */
 #define RESOLVED_INTRO "# Resolved from "
+#define RESOLVED_TAIL " (defaults filled in, --set applied)"
 #define ORIGIN_INTRO "# Where each key was given (a program that reads this file names those places):\n"
 #define ORIGIN_MARK "#@ "
-/* For a resolved file (first line RESOLVED_INTRO), gives each key that
+/* For a resolved file (first line RESOLVED_INTRO PATH RESOLVED_TAIL), takes
+ * PATH as c->origin and gives each key that
  * still has the value of its ORIGIN_MARK line that line's origin, so a
  * program that finds a problem in the copy names the user's file and line or
  * --set; other files: nothing. */

@@ -185,6 +185,19 @@ static int write_origins(FILE *f, const struct mps_case *c)
     return bad;
 }
 
+/* The user's case named in the resolved file's first line, line (RESOLVED_INTRO
+ * PATH RESOLVED_TAIL), into c->origin; a line of another shape leaves it. */
+static enum mps_status read_origin_path(struct mps_case *c, const char *line)
+{
+    const char *p = line + strlen(RESOLVED_INTRO);
+    size_t n = strcspn(p, "\r\n"), tn = strlen(RESOLVED_TAIL);
+    if (n <= tn || strncmp(p + n - tn, RESOLVED_TAIL, tn) != 0)
+        return MPS_OK;
+    free(c->origin);
+    c->origin = strndup(p, n - tn);
+    return c->origin ? MPS_OK : MPS_ENOMEM;
+}
+
 enum mps_status case_read_origins(struct mps_case *c, struct mps_err *err)
 {
     FILE *f = fopen(c->path, "r");
@@ -198,6 +211,10 @@ enum mps_status case_read_origins(struct mps_case *c, struct mps_err *err)
     while ((n = getline(&line, &cap, f)) > 0) {
         if (first && strncmp(line, RESOLVED_INTRO, strlen(RESOLVED_INTRO)) != 0)
             break; /* not a resolved case: its keys are where the file has them */
+        if (first && (st = read_origin_path(c, line))) {
+            mps_err_set(err, st, "%s: out of memory", c->path);
+            break;
+        }
         first = 0;
         if (strncmp(line, ORIGIN_MARK, strlen(ORIGIN_MARK)) != 0)
             continue;
@@ -245,7 +262,7 @@ enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *pa
         st = mps_err_set(err, MPS_EIO, "%s: cannot open for writing: %s", tmp, strerror(errno));
         goto done;
     }
-    int bad = fprintf(f, RESOLVED_INTRO "%s (defaults filled in, --set applied)\n%s%s", c->path,
+    int bad = fprintf(f, RESOLVED_INTRO "%s" RESOLVED_TAIL "\n%s%s", c->path,
                       comment ? comment : "", y) < 0;
     bad |= write_origins(f, c);
     bad |= fclose(f) != 0;

@@ -32,6 +32,32 @@ static int edit_distance(const char *a, const char *b)
     return d[m % 3][n];
 }
 
+/* A key whose first component is a typo for a section another program owns
+ * (an ignored prefix: "fluidd.rho" in the coupler, which leaves "fluid." to
+ * the fluid solver): "; did you mean fluid.rho?", the key in that section.
+ * Whether the rest is a key there is that program's to say. */
+static void suggest_section(const struct mps_case *c, const char *key, char *out, size_t n)
+{
+    size_t kn = strcspn(key, ".");
+    if (!key[kn] || kn >= KEY_MAX)
+        return;
+    char first[KEY_MAX], sect[KEY_MAX];
+    memcpy(first, key, kn);
+    first[kn] = '\0';
+    for (int i = 0; i < c->nignore; i++) {
+        size_t sn = strlen(c->ignore[i]);
+        if (sn < 2 || sn > KEY_MAX || c->ignore[i][sn - 1] != '.')
+            continue;
+        memcpy(sect, c->ignore[i], sn - 1);
+        sect[sn - 1] = '\0';
+        int limit = (int)(sn - 1) / 4 > 1 ? (int)(sn - 1) / 4 : 1;
+        if (strcmp(first, sect) != 0 && edit_distance(first, sect) <= limit) {
+            snprintf(out, n, "; did you mean %s%s?", sect, key + kn);
+            return;
+        }
+    }
+}
+
 /* Writes "; did you mean fluid.blocks.0.x0?" (with key's own indices) or "". */
 void case_suggest(const struct mps_case *c, const char *key, char *out, size_t n)
 {
@@ -79,8 +105,10 @@ void case_suggest(const struct mps_case *c, const char *key, char *out, size_t n
     }
     /* Near enough: a typo or two, more for long names. */
     int limit = best ? (int)strlen(best) / 4 : 0;
-    if (!best || bd > (limit > 1 ? limit : 1))
+    if (!best || bd > (limit > 1 ? limit : 1)) {
+        suggest_section(c, key, out, n);
         return;
+    }
 
     /* Show the spec back with the key's indices in place of its "*"s. */
     char shown_name[KEY_MAX];

@@ -4,7 +4,10 @@
  * --out is required; --solid, --fluid and --external are refused for a
  * solver the case does not need. The run's record (coupler_record.h) goes
  * into OUT/case_resolved.yml, which the solvers read.
- * It validates the whole case, launches the solvers the scene needs, talks to
+ * It validates its own and the common keys and the scene's layout (each solver
+ * validates its own keys when it gets CONFIG and answers a case error, which
+ * the coupler prints as its own: PROTOCOL.md 8), launches the solvers the
+ * scene needs, talks to
  * them over ZeroMQ (proto/PROTOCOL.md) and owns simulation time: each step
  * the fluid advances with the solid's interface as its moving boundary, and
  * the solid sub-cycles over the same interval under the fluid's loads
@@ -27,7 +30,6 @@
 #include "coupler_record.h"
 #include "coupling_accel.h"
 #include "coupling_iter.h"
-#include "fluid_params.h"
 #include "guard.h"
 #include "launch.h"
 #include "mps_case.h"
@@ -45,7 +47,6 @@
 #include "mps_version.h"
 #include "proto_link.h"
 #include "scene_check.h"
-#include "solid_scene.h"
 
 #define MAX_PROBES 64
 #define SLICE_MS 200
@@ -77,13 +78,9 @@ struct peer {
     char model[64];            /* as its HELLO announced it */
 };
 
-/* the case's key tables: common, fluid, solid, coupler, motion */
-#define NTABLES 5
-
 struct coupler {
     struct mps_case *cs;
     struct mps_motion *motion; /* the tank's motion, checked before launching */
-    const struct mps_key_spec *const *tables; /* the case's key tables (NTABLES) */
     struct coupler_record rec;
     const char *out;
     struct peer p[NPEERS];
@@ -106,6 +103,7 @@ struct coupler {
     long step;
     double wall0;
     char failed_peer[16];
+    int case_error;            /* a solver's case error (PROTOCOL.md 8) ended the run */
     /* implicit coupling (coupling.scheme: implicit) */
     int implicit;
     struct coupling_iter iter;
@@ -234,8 +232,13 @@ static enum mps_status wait_msg(struct coupler *c, int k, struct proto_msg *m, d
                 enum mps_status es = proto_error_status(m->text, &msg);
                 snprintf(c->failed_peer, sizeof c->failed_peer, "%s", c->p[q].name);
                 c->p[q].active = 0; /* it exits after ERROR */
-                st = mps_err_set(err, es == MPS_EINPUT ? MPS_EINPUT : (es ? es : MPS_EPEER),
-                                 "%s solver: %s: %s", c->p[q].name, mps_status_name(es), msg);
+                /* one of its keys: said as the coupler says its own */
+                if ((c->case_error = proto_case_error(m->text, &msg)))
+                    st = mps_err_set(err, MPS_EINPUT, "%s", msg);
+                else
+                    st = mps_err_set(err, es == MPS_EINPUT ? MPS_EINPUT : (es ? es : MPS_EPEER),
+                                     "%s solver: %s: %s", c->p[q].name, mps_status_name(es),
+                                     msg);
                 proto_msg_clear(m);
                 return st;
             }
@@ -375,9 +378,11 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
             p->can_rollback |= strcmp(tok, "rollback") == 0;
             p->can_checkpoint |= strcmp(tok, "checkpoint") == 0;
         }
-    char model[64] = "";
+    char model[64] = "", sets[256] = "";
     proto_text_get(m.text, ' ', "model", model, sizeof model);
     snprintf(p->model, sizeof p->model, "%s", model);
+    if (proto_text_get(m.text, ' ', "sets", sets, sizeof sets) < 0)
+        sets[0] = '\0'; /* too long for any key we would record: ignored */
     proto_msg_clear(&m);
     if (c->implicit && !p->can_rollback) {
         char reason[512];
@@ -420,8 +425,8 @@ static enum mps_status handshake(struct coupler *c, int k, const char *resolved_
     }
     /* the file this solver is about to read records its own run */
     enum mps_status rst = coupler_record_hello(
-        &c->rec, &c->cs, c->tables, NTABLES, k,
-        p->external ? "(external: started by the user)" : p->child.command, p->model, err);
+        &c->rec, &c->cs, k, p->external ? "(external: started by the user)" : p->child.command,
+        p->model, sets, err);
     if (rst)
         return rst;
     char cfg[8192];
@@ -1128,7 +1133,7 @@ static void cleanup(struct coupler *c)
     proto_msg_clear(&c->loads);
     coupling_iter_free(&c->iter);
     coupling_accel_destroy(&c->accel);
-    if (c->iter_log)
+    if (c->iter_log) /* closed by finish_run; here only when the run never got there */
         fclose(c->iter_log);
     mps_probes_close(&c->probes);
     mps_motion_destroy(&c->motion);
@@ -1178,13 +1183,16 @@ static int read_command_line(int argc, char **argv, struct mps_cli *cli,
     return -1;
 }
 
-/* Loads and checks the case (every key, the solvers' cross-key checks) and
- * decides which solvers run, before anything is written or launched. */
+/* Loads and checks the case (the common keys, the coupler's and the motion;
+ * the scene's layout across the solvers' sections) and decides which solvers
+ * run, before anything is written or launched. The solvers' keys are theirs
+ * to check, at CONFIG. */
 static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
                                  const struct mps_cli_extra opt[NOPTS], struct mps_err *err)
 {
-    enum mps_status st = mps_case_load(&c->cs, cli->case_path, c->rec.sets, c->rec.nsets,
-                                       c->tables, NTABLES, NULL, err);
+    enum mps_status st =
+        mps_case_load(&c->cs, cli->case_path, c->rec.sets, c->rec.nsets, coupler_case_tables,
+                      COUPLER_NTABLES, coupler_solver_sections, err);
     if (st)
         return st;
     c->hello_timeout = mps_case_double(c->cs, "coupling.hello_timeout");
@@ -1211,47 +1219,33 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
     for (int k = 0; k < NPEERS; k++)
         c->p[k].external = ext && strcmp(ext, c->p[k].name) == 0;
 
-    /* The solvers' cross-key checks (a block outside the tank, an empty clamp,
-     * ...) run here too, so an error names the user's file or --set, not the
-     * resolved copy, and nothing is launched for a case that cannot run. */
-    struct fluid_params fp;
-    struct solid_scene *sc = c->p[SOLID].needed ? malloc(sizeof *sc) : NULL;
-    if (c->p[SOLID].needed && !sc)
-        st = mps_err_set(err, MPS_ENOMEM, "coupler: out of memory");
-    else if (c->p[FLUID].needed)
-        st = fluid_params_read(&fp, c->cs, err);
-    if (!st && sc)
-        st = solid_scene_read(sc, c->cs, err);
-    if (!st && sc && c->p[FLUID].needed)
-        st = scene_check_fsi(&fp, sc, c->cs, err);
-    if (!st)
-        st = mps_motion_read(&c->motion, c->cs, err);
-    /* implicit coupling iterates on a fixed interface (coupling_iter.h):
-     * fracture changes it, and the MPS solid does not roll it back */
-    if (!st && c->implicit && !(c->p[FLUID].needed && c->p[SOLID].needed))
-        st = mps_case_fail(c->cs, err, "coupling.scheme",
-                           "implicit coupling needs a fluid and a solid");
-    if (!st && c->implicit && (sc->eps_max > 0.0 || sc->contact != SOLID_CONTACT_NONE))
-        st = mps_case_fail(c->cs, err, "coupling.scheme",
-                           "implicit coupling cannot be used with fracture or contact "
-                           "(solid.eps_max, solid.contact): the interface would change "
-                           "within a step");
-    free(sc);
+    /* The layout across the solvers' parts (a body outside the tank or in
+     * the water) is the coupler's to check, as no solver sees both; here, so
+     * nothing is launched for a scene that cannot run. */
+    if (c->p[FLUID].needed && c->p[SOLID].needed && (st = scene_check_fsi(c->cs, err)))
+        return st;
+    if ((st = mps_motion_read(&c->motion, c->cs, err)))
+        return st;
+    /* implicit coupling iterates on a fixed interface (coupling_iter.h); a
+     * solid that cannot roll its scene back (fracture) refuses rollback=on */
+    if (c->implicit && !(c->p[FLUID].needed && c->p[SOLID].needed))
+        return mps_case_fail(c->cs, err, "coupling.scheme",
+                             "implicit coupling needs a fluid and a solid");
     c->ck_interval = mps_case_double(c->cs, "output.checkpoint_interval");
     c->ck_asked = strcmp(mps_case_where(c->cs, "output.checkpoint_interval"), "default") != 0;
     /* the implicit scheme's history (the predictor, the acceleration's
      * columns and factor, the displacement reference) is not in the
      * checkpoints: refused when asked, off by default (docs/restart.md) */
-    if (!st && c->implicit && (c->restart || (c->ck_interval > 0.0 && c->ck_asked)))
-        st = mps_case_fail(c->cs, err, "coupling.scheme",
-                           "checkpoints and restarts of implicit coupling are not implemented "
-                           "(its iteration history is not saved): set output.checkpoint_interval"
-                           ": 0, or coupling.scheme: explicit");
-    if (!st && c->implicit && c->ck_interval > 0.0) {
+    if (c->implicit && (c->restart || (c->ck_interval > 0.0 && c->ck_asked)))
+        return mps_case_fail(c->cs, err, "coupling.scheme",
+                             "checkpoints and restarts of implicit coupling are not "
+                             "implemented (its iteration history is not saved): set "
+                             "output.checkpoint_interval: 0, or coupling.scheme: explicit");
+    if (c->implicit && c->ck_interval > 0.0) {
         c->ck_interval = 0.0;
         c->ck_note = "off: implicit coupling is not checkpointed";
     }
-    return st;
+    return MPS_OK;
 }
 
 /* Writes the run's record, opens the endpoints, launches the solvers and
@@ -1355,7 +1349,19 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
  * summary could not be written (err says which file). */
 static enum mps_status finish_run(struct coupler *c, enum mps_status st, struct mps_err *err)
 {
-    if (st) {
+    if (st && c->case_error) {
+        /* one line, as for the coupler's own keys; the solvers are stopped
+         * without a word (they print nothing on ABORT) */
+        fprintf(stderr, "coupler: %s\n", err->msg);
+        /* a solver whose handshake has not begun (the fluid, when the solid
+         * found the problem) has nothing to flush, and may not be connected
+         * yet to read ABORT: SIGTERM at once, not after the grace */
+        int idle = -1;
+        for (int k = 0; k < NPEERS; k++)
+            if (c->p[k].active && !c->p[k].engaged)
+                idle = k;
+        abort_all(c, err->msg, idle);
+    } else if (st) {
         fprintf(stderr, "\ncoupler: %s: %s\n", mps_status_name(st), err->msg);
         int hung = -1; /* the solver that missed a deadline, if that was the failure */
         for (int k = 0; k < NPEERS && st == MPS_ETIMEOUT; k++)
@@ -1380,6 +1386,18 @@ static enum mps_status finish_run(struct coupler *c, enum mps_status st, struct 
                     guard_refused(c->guard), guard_refused(c->guard) == 1 ? "" : "s", who);
     }
     struct mps_err werr;
+    /* iterations.csv is part of the record: a write lost on close is said */
+    if (c->iter_log) {
+        int bad = ferror(c->iter_log);
+        bad |= fclose(c->iter_log) != 0;
+        c->iter_log = NULL;
+        if (bad) {
+            fprintf(stderr, "coupler: %s%s/iterations.csv: cannot write: %s\n",
+                    st ? "also: " : "io: ", c->out, strerror(errno));
+            if (!st)
+                st = mps_err_set(err, MPS_EIO, "%s/iterations.csv: cannot write", c->out);
+        }
+    }
     if (write_summary(c, st, err, &werr)) {
         /* a failed run keeps its own status; a finished one fails here, since
          * its record is incomplete */
@@ -1440,10 +1458,6 @@ int main(int argc, char **argv)
     c.wall0 = mps_wall_seconds();
     c.p[FLUID].name = "fluid";
     c.p[SOLID].name = "solid";
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
-                                                 solid_case_keys, coupler_case_keys,
-                                                 mps_motion_keys};
-    c.tables = tables;
     coupler_record_init(&c.rec, &cli, opt[OPT_SOLID].value, opt[OPT_FLUID].value);
     enum mps_status st = load_case(&c, &cli, opt, &err);
     if (st) {

@@ -1,5 +1,7 @@
 #include "coupler_keys.h"
 
+#include "mps_motion.h"
+
 const struct mps_key_spec coupler_case_keys[] = {
     {"coupling.hello_timeout", MPS_KEY_DOUBLE, "60", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
      "s", "deadline for a launched solver to connect"},
@@ -51,3 +53,8 @@ const struct mps_key_spec coupler_case_keys[] = {
      "relaxation factor"},
     {NULL, 0, NULL, 0, 0, 0, NULL, NULL, NULL},
 };
+
+const struct mps_key_spec *const coupler_case_tables[COUPLER_NTABLES] = {
+    mps_case_common_keys, coupler_case_keys, mps_motion_keys};
+
+const char *const coupler_solver_sections[] = {"fluid.", "solid.", NULL};

@@ -1,5 +1,7 @@
 #include "coupler_record.h"
 
+#include "coupler_keys.h"
+
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -21,7 +23,8 @@ void coupler_record_init(struct coupler_record *r, const struct mps_cli *cli,
         snprintf(r->fluid_set, sizeof r->fluid_set, "fluid_solver=%s", fluid_cmd);
         r->sets[r->nsets++] = r->fluid_set;
     }
-    mps_prov_sets(r->sets, &r->nsets, (int)(sizeof r->sets / sizeof r->sets[0]) - 1);
+    /* room is left for the solvers' HELLO sets= */
+    mps_prov_sets(r->sets, &r->nsets, COUPLER_RECORD_MAX_SETS - COUPLER_RECORD_HELLO_SETS);
 }
 
 enum mps_status coupler_record_write(const struct coupler_record *r, const struct mps_case *c,
@@ -48,26 +51,40 @@ enum mps_status coupler_record_write(const struct coupler_record *r, const struc
     return st;
 }
 
-enum mps_status coupler_record_hello(struct coupler_record *r, struct mps_case **c,
-                                     const struct mps_key_spec *const *tables, int ntables,
-                                     int peer, const char *command, const char *model,
+enum mps_status coupler_record_hello(struct coupler_record *r, struct mps_case **c, int peer,
+                                     const char *command, const char *model, const char *sets,
                                      struct mps_err *err)
 {
     const char *role = peer == COUPLER_RECORD_SOLID ? "solid" : "fluid";
     /* our solid_solver without --model says "case": it runs solid.model */
     snprintf(r->hello[peer], sizeof r->hello[peer], "%s program: %s (HELLO model=%s%s)", role,
              command, model, strcmp(model, "case") == 0 ? ": the case's solid.model" : "");
-    if (peer == COUPLER_RECORD_SOLID && strcmp(model, mps_case_string(*c, "solid.model")) != 0 &&
-        (size_t)snprintf(r->model_set, sizeof r->model_set, "solid.model=%s", model) <
-            sizeof r->model_set) {
-        /* A model the key cannot name (modal_beam, fake, or "case": the
-         * case's own) leaves the case as it is; the comment says what ran. */
-        int n = r->nsets;
-        r->sets[n++] = r->model_set;
+    /* HELLO sets=KEY:VALUE,...: keys of the solver's own section that its
+     * command line set (solid_solver --model tlsph: solid.model:tlsph). The
+     * solver owns them, so they are taken as said; keys of another section
+     * are not the solver's to set and are left out. */
+    char section[8];
+    snprintf(section, sizeof section, "%s.", role);
+    int n = r->nsets;
+    for (const char *p = sets ? sets : "";
+         *p && n < COUPLER_RECORD_MAX_SETS && r->nhello < COUPLER_RECORD_HELLO_SETS;) {
+        size_t len = strcspn(p, ",");
+        const char *colon = memchr(p, ':', len);
+        char *item = r->hello_sets[r->nhello];
+        if (colon && strncmp(p, section, strlen(section)) == 0 && colon > p + strlen(section) &&
+            (size_t)snprintf(item, sizeof r->hello_sets[0], "%.*s=%.*s", (int)(colon - p), p,
+                             (int)(len - (size_t)(colon - p) - 1),
+                             colon + 1) < sizeof r->hello_sets[0]) {
+            r->sets[n++] = item;
+            r->nhello++;
+        }
+        p += len + (p[len] == ',');
+    }
+    if (n > r->nsets) {
         struct mps_case *again = NULL;
         struct mps_err ignored;
-        if (mps_case_load(&again, r->case_path, r->sets, n, tables, ntables, NULL, &ignored) ==
-            MPS_OK) {
+        if (mps_case_load(&again, r->case_path, r->sets, n, coupler_case_tables, COUPLER_NTABLES,
+                          coupler_solver_sections, &ignored) == MPS_OK) {
             mps_case_destroy(c);
             *c = again;
             r->nsets = n;

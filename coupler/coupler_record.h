@@ -13,11 +13,17 @@
 
 enum { COUPLER_RECORD_FLUID = 0, COUPLER_RECORD_SOLID = 1, COUPLER_RECORD_PEERS = 2 };
 
+/* a solver's HELLO sets= items the record takes, per run (both solvers) */
+#define COUPLER_RECORD_HELLO_SETS 8
+#define COUPLER_RECORD_MAX_SETS (MPS_CLI_MAX_SETS + 2 + MPS_PROV_NSETS + COUPLER_RECORD_HELLO_SETS)
+
 struct coupler_record {
     const char *case_path;
-    const char *sets[MPS_CLI_MAX_SETS + 3 + MPS_PROV_NSETS];
+    const char *sets[COUPLER_RECORD_MAX_SETS];
     int nsets;
-    char solid_set[4200], fluid_set[4200], model_set[96];
+    char solid_set[4200], fluid_set[4200];
+    char hello_sets[COUPLER_RECORD_HELLO_SETS][256];
+    int nhello;
     char path[4200];                           /* OUT/case_resolved.yml, absolute */
     char hello[COUPLER_RECORD_PEERS][320];     /* "fluid: COMMAND (model NAME)" */
 };
@@ -32,13 +38,13 @@ enum mps_status coupler_record_write(const struct coupler_record *r, const struc
                                      struct mps_err *err);
 
 /* Records a solver's HELLO (peer: COUPLER_RECORD_*; command as launched;
- * model as announced). For the solid, a model that solid.model accepts and
- * the case does not already name is set there: *c is reloaded with it. Then
+ * model as announced; sets: its HELLO sets= value, "KEY:VALUE,...", or NULL).
+ * The items of sets in the solver's own section ("solid." for the solid) are
+ * applied to the case after the user's: *c is reloaded with them. Then
  * rewrites the file. Call between the HELLO and the CONFIG that hands the
  * solver the file, so the solver reads the record of its own run. */
-enum mps_status coupler_record_hello(struct coupler_record *r, struct mps_case **c,
-                                     const struct mps_key_spec *const *tables, int ntables,
-                                     int peer, const char *command, const char *model,
+enum mps_status coupler_record_hello(struct coupler_record *r, struct mps_case **c, int peer,
+                                     const char *command, const char *model, const char *sets,
                                      struct mps_err *err);
 
 #endif

@@ -279,7 +279,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->ppe_coarse_cell = mps_case_double(c, "fluid.ppe_coarse_cell");
     if (!mps_case_has(c, "fluid.tank.width") || !mps_case_has(c, "fluid.tank.height"))
         return mps_err_set(err, MPS_EINPUT, "%s: missing required key '%s' (the fluid needs a tank)",
-                           mps_case_path(c),
+                           mps_case_origin(c),
                            mps_case_has(c, "fluid.tank.width") ? "fluid.tank.height"
                                                                  : "fluid.tank.width");
     p->tank_w = mps_case_double(c, "fluid.tank.width");
@@ -309,7 +309,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
         snprintf(key, sizeof key, "fluid.blocks.%d.x0", b);
         if (!mps_case_has(c, "%s", key)) /* an item given by --set past the end */
             return mps_err_set(err, MPS_EINPUT, "%s: fluid.blocks.%d: missing (a gap in the "
-                               "list of blocks)", mps_case_path(c), b);
+                               "list of blocks)", mps_case_origin(c), b);
         for (int k = 0; k < 4; k++)
             p->block[b][k] = mps_case_double(c, "fluid.blocks.%d.%s", b, names[k]);
         snprintf(key, sizeof key, "fluid.blocks.%d.x1", b);
@@ -377,7 +377,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     for (int k = 0; k < p->nprobes; k++) {
         if (!mps_case_has(c, "fluid.probes.%d.name", k))
             return mps_err_set(err, MPS_EINPUT, "%s: fluid.probes.%d: missing (a gap in the "
-                               "list of probes)", mps_case_path(c), k);
+                               "list of probes)", mps_case_origin(c), k);
         p->probes[k].name = mps_case_string(c, "fluid.probes.%d.name", k);
         p->probes[k].kind = probe_kind(mps_case_string(c, "fluid.probes.%d.kind", k));
         p->probes[k].x = mps_case_double(c, "fluid.probes.%d.x", k);

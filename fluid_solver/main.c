@@ -285,8 +285,13 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
         mps_prov_sets(all, &nall, MPS_CLI_MAX_SETS + MPS_PROV_NSETS);
     enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, tables, 3, ignore, err);
     struct fluid_params prm;
-    if (st || (st = fluid_params_read(&prm, r->cs, err)) ||
-        (st = mps_motion_read(&r->motion, r->cs, err)) || (st = mps_mkdir_p(r->out, err)))
+    if (!st && !(st = fluid_params_read(&prm, r->cs, err)))
+        st = mps_motion_read(&r->motion, r->cs, err);
+    /* the fluid owns its keys: under the coupler a problem with one is a case
+     * error, which the coupler prints as its own (PROTOCOL.md 8) */
+    if (st && r->coupled)
+        return proto_solver_case_error(st, err);
+    if (st || (st = mps_mkdir_p(r->out, err)))
         return st;
     prm.motion = r->motion;
     if ((st = fluid_create(&r->f, &prm, err)))
@@ -497,10 +502,10 @@ static int run_coupled(const char *endpoint, int hello_timeout_ms)
     static const struct proto_solver_ops ops = {"fluid",     "mps",       peer_configure,
                                                 peer_ready,  peer_advance, peer_finish,
                                                 peer_save,   peer_restore, 1,
-                                                peer_checkpoint, peer_resume};
+                                                peer_checkpoint, peer_resume, NULL};
     enum mps_status st =
         proto_solver_run(endpoint, &ops, &r, hello_timeout_ms, &stop_signal, &r.peer, &err);
-    if (st)
+    if (st && !r.peer.coupler_reports)
         fprintf(stderr, "fluid_solver: %s: %s\n", mps_status_name(st), err.msg);
     teardown(&r);
     return mps_status_exit_code(st);

@@ -261,6 +261,17 @@ enum mps_status proto_error_status(const char *text, const char **message)
     return code;
 }
 
+int proto_case_error(const char *text, const char **line)
+{
+    const char *rest = NULL;
+    if (proto_error_status(text, &rest) != MPS_EINPUT || !rest ||
+        strncmp(rest, PROTO_CASE_ERROR, strlen(PROTO_CASE_ERROR)) != 0)
+        return 0;
+    if (line)
+        *line = rest + strlen(PROTO_CASE_ERROR);
+    return 1;
+}
+
 /* ---- semantic checks shared by encode and decode ---- */
 
 __attribute__((format(printf, 3, 4)))

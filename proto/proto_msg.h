@@ -127,4 +127,12 @@ int proto_text_get(const char *text, char sep, const char *key, char *buf, size_
  * NULL) is set to the part after "status: ". */
 enum mps_status proto_error_status(const char *text, const char **message);
 
+/* A case error (PROTOCOL.md 8): an ERROR "input: case: LINE" by which a solver
+ * says one of its case keys is wrong, LINE being the one-line message the
+ * coupler would print for a key of its own ("case.yml:14: solid.bodies.0.E =
+ * -1: must be > 0"). */
+#define PROTO_CASE_ERROR "case: "
+/* 1 and *line (may be NULL) set to LINE if text is a case error; else 0. */
+int proto_case_error(const char *text, const char **line);
+
 #endif

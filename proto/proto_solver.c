@@ -77,9 +77,9 @@ static enum mps_status rollback(const struct proto_solver_ops *ops, void *self,
     return st;
 }
 
-/* Best effort: tell the coupler why we stop. */
-static void send_error(void *sock, const struct proto_msg *last, enum mps_status st,
-                       const struct mps_err *err)
+/* Best effort: tell the coupler why we stop. MPS_OK if the ERROR went out. */
+static enum mps_status send_error(void *sock, const struct proto_msg *last, enum mps_status st,
+                                  const struct mps_err *err)
 {
     char text[1200];
     snprintf(text, sizeof text, "%s: %s", mps_status_name(st), err->msg);
@@ -90,7 +90,14 @@ static void send_error(void *sock, const struct proto_msg *last, enum mps_status
         e.time = last->time;
     }
     struct mps_err ignored;
-    proto_link_send(sock, &e, &ignored);
+    return proto_link_send(sock, &e, &ignored);
+}
+
+enum mps_status proto_solver_case_error(enum mps_status st, struct mps_err *err)
+{
+    if (st == MPS_EINPUT && strncmp(err->msg, PROTO_CASE_ERROR, strlen(PROTO_CASE_ERROR)) != 0)
+        mps_err_prefix(err, "%s", PROTO_CASE_ERROR);
+    return st;
 }
 
 enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver_ops *ops,
@@ -133,15 +140,16 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
     if (st)
         goto done;
 
-    char hello[256];
+    char hello[512];
     const int can_roll = ops->save && ops->restore;
     const int can_ckpt = ops->checkpoint && ops->resume;
-    snprintf(hello, sizeof hello, "role=%s model=%s pid=%d build=%s%s", ops->role, ops->model,
+    snprintf(hello, sizeof hello, "role=%s model=%s pid=%d build=%s%s%s%s", ops->role, ops->model,
              (int)getpid(), MPS_VERSION,
              can_roll && can_ckpt ? " caps=rollback,checkpoint"
              : can_roll           ? " caps=rollback"
              : can_ckpt           ? " caps=checkpoint"
-                                  : "");
+                                  : "",
+             ops->sets ? " sets=" : "", ops->sets ? ops->sets : "");
     reply = proto_msg_make(PROTO_HELLO);
     reply.text = hello;
     if ((st = proto_link_send(sock, &reply, err)))
@@ -153,6 +161,12 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         st = mps_err_set(err, MPS_EPROTO, "the coupler refused this solver: %s",
                          in.text ? in.text : "(no reason)");
         said_error = 1; /* no reply to a REJECT */
+        goto done;
+    }
+    if (in.type == PROTO_ABORT) { /* another solver's error ends the run before it began */
+        st = mps_err_set(err, MPS_EPEER, "aborted by the coupler: %s",
+                         in.text ? in.text : "(no reason)");
+        said_error = stats->coupler_reports = 1; /* no reply to ABORT */
         goto done;
     }
     if (in.type != PROTO_CONFIG) {
@@ -247,7 +261,7 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
         if (in.type == PROTO_ABORT) {
             st = mps_err_set(err, MPS_EPEER, "aborted by the coupler: %s",
                              in.text ? in.text : "(no reason)");
-            said_error = 1; /* no reply to ABORT */
+            said_error = stats->coupler_reports = 1; /* no reply to ABORT */
             goto done;
         }
         if (in.type == PROTO_STOP) {
@@ -300,8 +314,13 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
     }
 
 fail:
-    if (sock && !said_error && st != MPS_EPEER)
-        send_error(sock, &in, st, err);
+    if (sock && !said_error && st != MPS_EPEER && send_error(sock, &in, st, err) == MPS_OK &&
+        st == MPS_EINPUT && strncmp(err->msg, PROTO_CASE_ERROR, strlen(PROTO_CASE_ERROR)) == 0)
+        stats->coupler_reports = 1; /* the coupler prints it as its own */
+    /* stopped by a signal before CONFIG: it has done nothing, and the run's
+     * end (the other solver's error, Ctrl-C) is the coupler's to tell */
+    if (st == MPS_EINTR && !configured)
+        stats->coupler_reports = 1;
 done:
     if (configured) {
         char *json = ops->finish(self, st, err);

@@ -51,6 +51,11 @@ struct proto_solver_ops {
      * READY then reports the state of that moment. */
     enum mps_status (*checkpoint)(void *self, long number, double time, struct mps_err *err);
     enum mps_status (*resume)(void *self, long number, struct mps_err *err);
+    /* Optional (NULL: none): case keys of the solver's own section that its
+     * command line sets, "KEY:VALUE,..." (HELLO sets=, PROTOCOL.md 4), e.g.
+     * "solid.model:tlsph" for solid_solver --model tlsph; the coupler records
+     * them in the run's case, which the solvers then read. */
+    const char *sets;
 };
 
 /* Timing of the conversation, for the solver's summary. */
@@ -65,6 +70,11 @@ struct proto_solver_stats {
     long restart;             /* CONFIG restart=N (0: a new run), set before configure */
     long checkpoints;         /* the last checkpoint's number */
     double checkpoint_seconds; /* inside checkpoint (part of compute_seconds) */
+    /* 1: the run ended with ABORT, with a case error sent to the coupler
+     * (proto_solver_case_error), or with a signal before CONFIG: the coupler
+     * tells the user why, on its own terminal, so the solver program prints
+     * nothing (a case error is then one line, as the coupler's own are) */
+    int coupler_reports;
 };
 
 /* Runs the conversation on endpoint until STOP (MPS_OK), ABORT (MPS_EPEER),
@@ -83,6 +93,14 @@ enum mps_status proto_solver_run(const char *endpoint, const struct proto_solver
  * --connect, 0 if not, -1 (err set) if the coupled arguments are malformed. */
 int proto_solver_args(int argc, char **argv, const char **endpoint, int *hello_timeout_ms,
                       struct mps_err *err);
+
+/* For configure: marks st, the outcome of validating the solver's own case
+ * keys (reading them and the checks across them), as a case error when it is
+ * MPS_EINPUT; the loop then sends ERROR "input: case: MESSAGE" (PROTOCOL.md 8),
+ * which the coupler prints as it prints its own keys' errors. err->msg must be
+ * one line naming where, the key and the problem (mps_case_fail's). Returns
+ * st. */
+enum mps_status proto_solver_case_error(enum mps_status st, struct mps_err *err);
 
 /* "a,b,c" from n names into buf (size len); returns buf. */
 char *proto_join_names(const char *const *names, int n, char *buf, size_t len);

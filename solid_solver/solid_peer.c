@@ -38,6 +38,7 @@ struct peer {
     char prefix[64];
     char restart_path[4400];
     double restart_time;
+    int fracture;          /* the scene has fracture or contact (solid.eps_max, solid.contact) */
 };
 
 static enum mps_status snapshot(struct peer *p, double t, long step, struct mps_err *err)
@@ -78,8 +79,19 @@ static enum mps_status configure(void *self, const char *case_path, const char *
         snprintf(model_set, sizeof model_set, "solid.model=%s", p->ops->name);
     enum mps_status st =
         mps_case_load(&p->cs, case_path, sets, p->ops ? 1 : 0, tables, 3, ignore, err);
+    /* the solid owns its keys: a problem with one, or across them, is a case
+     * error, which the coupler prints as its own (PROTOCOL.md 8); what the
+     * model then cannot do is a plain input error of this solver */
+    struct solid_scene *sc = st ? NULL : malloc(sizeof *sc);
+    if (!st && !sc)
+        return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
+    if (!st)
+        st = solid_scene_read(sc, p->cs, err);
+    if (!st)
+        p->fracture = sc->eps_max > 0.0 || sc->contact != SOLID_CONTACT_NONE;
+    free(sc);
     if (st)
-        return st;
+        return proto_solver_case_error(st, err);
     if (!p->ops && !(p->ops = solid_model_find(mps_case_string(p->cs, "solid.model"))))
         return mps_case_fail(p->cs, err, "solid.model", "unknown model (known: %s)",
                              solid_model_names());
@@ -183,6 +195,16 @@ static enum mps_status advance(void *self, const struct proto_msg *in, struct pr
 static enum mps_status save(void *self, struct mps_err *err)
 {
     struct peer *p = self;
+    /* the first save, with rollback=on before READY: implicit coupling
+     * iterates on a fixed interface (coupling_iter.h), which fracture and
+     * contact change; a problem of the case's keys, said as one */
+    if (p->fracture && p->stats.advances == 0)
+        return proto_solver_case_error(
+            mps_case_fail(p->cs, err, "coupling.scheme",
+                          "implicit coupling cannot be used with fracture or contact "
+                          "(solid.eps_max, solid.contact): the interface would change "
+                          "within a step"),
+            err);
     enum mps_status st;
     if (!p->ops->state_put)
         return mps_err_set(err, MPS_EINPUT, "solid model %s cannot roll back a step",
@@ -278,11 +300,15 @@ int solid_peer_run(const char *endpoint, const struct solid_model_ops *ops, int 
     /* every model of this program can roll back (a scene that cannot is
      * refused by its save) */
     struct proto_solver_ops pops = {"solid", ops ? ops->name : "case", configure, ready, advance,
-                                    finish, save, restore, 1, checkpoint, resume};
+                                    finish, save, restore, 1, checkpoint, resume, NULL};
+    /* --model NAME is solid.model, recorded by the coupler in the run's case */
+    char sets[96];
+    if (ops && (size_t)snprintf(sets, sizeof sets, "solid.model:%s", ops->name) < sizeof sets)
+        pops.sets = sets;
     struct mps_err err = {0};
     enum mps_status st =
         proto_solver_run(endpoint, &pops, &p, hello_timeout_ms, stop_flag, &p.stats, &err);
-    if (st)
+    if (st && !p.stats.coupler_reports)
         fprintf(stderr, "solid_solver: %s: %s\n", mps_status_name(st), err.msg);
     mps_h5_close(&p.h5);
     if (p.model)

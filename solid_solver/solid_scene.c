@@ -168,16 +168,11 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
                      : strcmp(v, "bodies") == 0 ? SOLID_CONTACT_BODIES
                                                 : SOLID_CONTACT_NONE;
     }
-    if ((s->eps_max > 0.0 || s->contact != SOLID_CONTACT_NONE) &&
-        strcmp(mps_case_string(c, "solid.model"), "mps") != 0)
-        return mps_case_fail(c, err, s->eps_max > 0.0 ? "solid.eps_max" : "solid.contact",
-                             "fracture and contact are in the mps model only (solid.model = %s)",
-                             mps_case_string(c, "solid.model"));
 
     s->nbodies = mps_case_count(c, "solid.bodies");
     if (s->nbodies == 0)
         return mps_err_set(err, MPS_EINPUT, "%s: solid.bodies: no solid body given",
-                           mps_case_path(c));
+                           mps_case_origin(c));
     if (s->nbodies > SOLID_MAX_BODIES)
         return mps_case_fail(c, err, "solid.bodies", "%d bodies: at most %d", s->nbodies,
                              SOLID_MAX_BODIES);
@@ -186,7 +181,7 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
         snprintf(key, sizeof key, "solid.bodies.%d.name", b);
         if (!mps_case_has(c, "%s", key))
             return mps_err_set(err, MPS_EINPUT, "%s: solid.bodies.%d: missing (a gap in the "
-                               "list of bodies)", mps_case_path(c), b);
+                               "list of bodies)", mps_case_origin(c), b);
         copy_name(d->name, mps_case_string(c, "%s", key));
         d->x0 = mps_case_double(c, "solid.bodies.%d.x0", b);
         d->y0 = mps_case_double(c, "solid.bodies.%d.y0", b);
@@ -243,7 +238,7 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
         snprintf(key, sizeof key, "solid.clamps.%d.body", k);
         if (!mps_case_has(c, "%s", key))
             return mps_err_set(err, MPS_EINPUT, "%s: solid.clamps.%d: missing (a gap in the "
-                               "list of clamps)", mps_case_path(c), k);
+                               "list of clamps)", mps_case_origin(c), k);
         const char *name = mps_case_string(c, "%s", key);
         d->body = -1;
         for (int b = 0; b < s->nbodies; b++)
@@ -275,7 +270,7 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
         snprintf(key, sizeof key, "solid.probes.%d.name", k);
         if (!mps_case_has(c, "%s", key))
             return mps_err_set(err, MPS_EINPUT, "%s: solid.probes.%d: missing (a gap in the "
-                               "list of probes)", mps_case_path(c), k);
+                               "list of probes)", mps_case_origin(c), k);
         copy_name(d->name, mps_case_string(c, "%s", key));
         static const char *const kinds[] = {"dx",     "dy",      "x",       "y",     "tank_angle",
                                             "energy", "force_x", "force_y", "moment"};

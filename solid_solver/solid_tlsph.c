@@ -602,6 +602,12 @@ static enum mps_status op_create(void **self, const struct mps_case *c, struct m
         return mps_err_set(err, MPS_ENOMEM, "solid: out of memory");
     enum mps_status st = solid_scene_read(sc, c, err);
     struct solid_tlsph *s = NULL;
+    /* the model's limit, not the keys': under the coupler a plain input error
+     * naming the solver, since a --model of its command chose the model */
+    if (st == MPS_OK && (sc->eps_max > 0.0 || sc->contact != SOLID_CONTACT_NONE))
+        st = mps_case_fail(c, err, sc->eps_max > 0.0 ? "solid.eps_max" : "solid.contact",
+                           "fracture and contact are in the mps model only (solid.model = %s)",
+                           mps_case_string(c, "solid.model"));
     if (st == MPS_OK)
         st = solid_tlsph_create(
             &s, sc, mps_case_double(c, "solid.tlsph.alpha"),

@@ -513,3 +513,123 @@ def recv(sock, timeout_ms: int) -> Message:
     if not sock.poll(timeout_ms, zmq.POLLIN):
         raise TimeoutError(f"no message within {timeout_ms} ms")
     return decode(sock.recv_multipart(copy=True))
+
+
+# ---- a solver's own case keys (PROTOCOL.md 4 and 8, "Case error") ----
+
+CASE_ERROR = "case: "
+RESOLVED_INTRO = "# Resolved from "
+RESOLVED_TAIL = " (defaults filled in, --set applied)"
+ORIGIN_MARK = "#@ "
+
+
+def case_error(text: str):
+    """The LINE of an ERROR text "input: case: LINE", or None for any other text."""
+    status, message = error_status(text)
+    if status == "input" and message.startswith(CASE_ERROR):
+        return message[len(CASE_ERROR):]
+    return None
+
+
+class CaseError(Exception):
+    """One of the solver's case keys is wrong. str(e) is the one line
+    "WHERE: KEY = VALUE: problem"; the solver sends ERROR
+    "input: case: " + str(e) and exits 2, and the coupler prints the line as
+    its own."""
+
+
+class Case:
+    """A case file as flat dotted keys ("solid.bodies.0.E"), each with where
+    it was given: for the coupler's resolved copy, the user's "case.yml:LINE"
+    or "--set KEY=VALUE" from its "#@ KEY<TAB>WHERE<TAB>VALUE" lines (while
+    the copy still holds that value), else this file's line. Values are the
+    scalars as written; the getters check them and raise CaseError."""
+
+    def __init__(self, path: str):
+        import yaml  # only solvers that read the case need PyYAML
+
+        with open(path) as f:
+            text = f.read()
+        lines = text.splitlines()
+        first = lines[0] if lines else ""
+        resolved = first.startswith(RESOLVED_INTRO)
+        # a key that is missing is named in the user's file, as the coupler would
+        self.file = first[len(RESOLVED_INTRO):-len(RESOLVED_TAIL)] \
+            if resolved and first.endswith(RESOLVED_TAIL) else path
+        self.values, self.where = {}, {}
+        try:
+            root = yaml.compose(text)
+        except yaml.YAMLError as e:
+            mark = getattr(e, "problem_mark", None)
+            raise CaseError(f"{path}:{mark.line + 1 if mark else 0}: YAML syntax error: "
+                            f"{getattr(e, 'problem', e)}") from e
+        if root is not None:
+            self._flatten(root, "", path)
+        for line in lines if resolved else ():
+            if line.startswith(ORIGIN_MARK):
+                parts = line[len(ORIGIN_MARK):].split("\t")
+                if len(parts) == 3 and self.values.get(parts[0]) == parts[2]:
+                    self.where[parts[0]] = parts[1]
+
+    def _flatten(self, node, prefix, path):
+        import yaml
+
+        if isinstance(node, yaml.MappingNode):
+            for k, v in node.value:
+                self._flatten(v, f"{prefix}.{k.value}" if prefix else str(k.value), path)
+        elif isinstance(node, yaml.SequenceNode):
+            for i, v in enumerate(node.value):
+                self._flatten(v, f"{prefix}.{i}", path)
+        else:
+            self.values[prefix] = node.value
+            self.where[prefix] = f"{path}:{node.start_mark.line + 1}"
+
+    def has(self, key: str) -> bool:
+        return key in self.values
+
+    def count(self, prefix: str) -> int:
+        """Items of the sequence at prefix: 1 + the largest index given."""
+        idx = [int(k[len(prefix) + 1:].split(".")[0]) for k in self.values
+               if k.startswith(prefix + ".") and k[len(prefix) + 1:].split(".")[0].isdigit()]
+        return max(idx) + 1 if idx else 0
+
+    def fail(self, key: str, problem: str):
+        """Raises the CaseError "WHERE: KEY = VALUE: problem" for key."""
+        if key in self.values:
+            shown = self.values[key] if self.values[key] != "" else "(empty)"
+            raise CaseError(f"{self.where[key]}: {key} = {shown}: {problem}")
+        raise CaseError(f"{self.file}: {key}: {problem}")
+
+    def number(self, key: str, default=None, lo=None, lo_open=False, hi=None, hi_open=False):
+        """The value of key as a finite number within the bounds given (as the
+        C solvers word them: "must be > 0", "must be in (0, 1]")."""
+        if key not in self.values:
+            if default is None:
+                raise CaseError(f"{self.file}: missing required key '{key}'")
+            return float(default)
+        try:
+            v = float(self.values[key])
+        except ValueError:
+            self.fail(key, "must be a number")
+        if not math.isfinite(v):
+            self.fail(key, "must be a finite number")
+        low = lo is not None and (v <= lo if lo_open else v < lo)
+        high = hi is not None and (v >= hi if hi_open else v > hi)
+        if low or high:
+            if hi is None:
+                self.fail(key, f"must be {'>' if lo_open else '>='} {lo:g}")
+            if lo is None:
+                self.fail(key, f"must be {'<' if hi_open else '<='} {hi:g}")
+            self.fail(key, f"must be in {'(' if lo_open else '['}{lo:g}, {hi:g}"
+                           f"{')' if hi_open else ']'}")
+        return v
+
+    def only(self, prefix: str, known):
+        """Refuses a key under prefix (a section the solver owns) that is not
+        one of known: "unknown key", with the nearest as a suggestion."""
+        import difflib
+
+        for key in self.values:
+            if key.startswith(prefix) and key not in known:
+                near = difflib.get_close_matches(key, list(known), n=1, cutoff=0.8)
+                self.fail(key, "unknown key" + (f"; did you mean {near[0]}?" if near else ""))

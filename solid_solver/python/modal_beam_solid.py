@@ -38,7 +38,6 @@ import json, math, os, sys, time
 
 import h5py
 import numpy as np
-import yaml
 import zmq
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'proto',
@@ -61,14 +60,38 @@ def mode(s, L):
     return raw(s) / tip, raw2(s) / tip
 
 
+# Its own keys, which no other program knows (PROTOCOL.md 4: the solid's
+# section is the solid's): the coupler hands them over unread.
+OWN_KEYS = {'solid.modal_beam.courant': 'fraction of the stable step 2/omega_1 / 10 '
+                                        '(default: --courant, 0.5)'}
+
+
 class Beam:
     def __init__(self, case, courant):
-        dp = float(case['dp'])
-        body = case['solid']['bodies'][0]
-        x0, y0, x1, y1 = (float(body[k]) for k in ('x0', 'y0', 'x1', 'y1'))
-        rho, E = float(body['rho']), float(body['E'])
-        clamps = case['solid'].get('clamps', [])
-        root = max([float(c['y1']) for c in clamps] + [y0])
+        """case: an mp.Case. Each key this solid reads is checked here, and a
+        wrong one raises mp.CaseError naming where it was given."""
+        case.only('solid.modal_beam.', OWN_KEYS)
+        courant = case.number('solid.modal_beam.courant', courant, lo=0.0, lo_open=True, hi=1.0)
+        dp = case.number('dp', lo=0.0, lo_open=True)
+        nb = case.count('solid.bodies')
+        if nb == 0:
+            raise mp.CaseError(f'{case.file}: solid.bodies: no solid body given')
+        if nb > 1:  # not silently dropped
+            case.fail('solid.bodies.1.name' if case.has('solid.bodies.1.name') else
+                      'solid.bodies.1', 'the modal beam solid models one body')
+        b = 'solid.bodies.0'
+        x0, y0, x1, y1 = (case.number(f'{b}.{k}') for k in ('x0', 'y0', 'x1', 'y1'))
+        if x1 <= x0:
+            case.fail(f'{b}.x1', f'must be > x0 = {x0:g}')
+        if y1 <= y0:
+            case.fail(f'{b}.y1', f'must be > y0 = {y0:g}')
+        rho = case.number(f'{b}.rho', lo=0.0, lo_open=True)
+        E = case.number(f'{b}.E', lo=0.0, lo_open=True)
+        clamp_tops = [case.number(f'solid.clamps.{k}.y1') for k in range(case.count('solid.clamps'))]
+        root = max(clamp_tops + [y0])
+        if root >= y1:
+            case.fail(f'solid.clamps.{clamp_tops.index(root)}.y1',
+                      'the clamp covers the whole plate: nothing is left to bend')
         nx, ny = int(math.floor((x1 - x0) / dp + 1e-6)), int(math.floor((y1 - y0) / dp + 1e-6))
         ii, jj = np.meshgrid(np.arange(nx), np.arange(ny))
         self.x0 = np.column_stack([x0 + (ii.ravel() + 0.5) * dp, y0 + (jj.ravel() + 0.5) * dp])
@@ -231,6 +254,8 @@ def converse(sock, courant, t_wall):
     if cfg.type == mp.Type.REJECT:
         print(f'modal_beam_solid: refused: {cfg.text}', file=sys.stderr)
         return 1  # no reply to a REJECT
+    if cfg.type == mp.Type.ABORT:
+        return 1  # the other solver failed first (PROTOCOL.md 6): the coupler says why
     if cfg.type != mp.Type.CONFIG:
         raise Fail('protocol', f'expected CONFIG or REJECT after HELLO, got {mp.Type(cfg.type).name}')
     conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
@@ -245,9 +270,11 @@ def converse(sock, courant, t_wall):
     try:
         with open(conf['case']) as f:
             config_text = f.read()
-        case = yaml.safe_load(config_text)
-        beam = Beam(case, courant)
-    except (OSError, KeyError, TypeError, ValueError, IndexError, yaml.YAMLError) as e:
+        beam = Beam(mp.Case(conf['case']), courant)
+    except mp.CaseError as e:
+        # PROTOCOL.md 8: one of its keys; the coupler prints the line as its own
+        raise Fail('input', mp.CASE_ERROR + str(e)) from e
+    except (OSError, KeyError, TypeError, ValueError, IndexError) as e:
         raise Fail('input', f"case {conf['case']}: {type(e).__name__}: {e}") from e
     timeout = int(conf.get('timeout_ms', '1800000'))
     if conf.get('rollback', 'off') not in ('on', 'off'):
@@ -283,8 +310,7 @@ def converse(sock, courant, t_wall):
             mp.send(sock, mp.Message(mp.Type.BYE, step=m.step, time=m.time, text=json.dumps(summary)))
             return 0
         if m.type == mp.Type.ABORT:
-            print(f'modal_beam_solid: aborted by the coupler: {m.text}', file=sys.stderr)
-            return 1  # no reply to ABORT
+            return 1  # no reply to ABORT; the coupler tells the user why
         if m.type != mp.Type.ADVANCE:
             raise Fail('protocol', f'expected ADVANCE, STOP or ABORT, got {mp.Type(m.type).name}')
         c0 = time.time()
@@ -339,7 +365,8 @@ def main():
         text = str(e) if isinstance(e, Fail) else \
             f"{'protocol' if isinstance(e, mp.ProtocolError) else 'timeout'}: {e}"
         status = text.split(':', 1)[0]
-        print(f'modal_beam_solid: {text}', file=sys.stderr)
+        if not mp.case_error(text):  # a case error is the coupler's to print (PROTOCOL.md 8)
+            print(f'modal_beam_solid: {text}', file=sys.stderr)
         try:
             mp.send(sock, mp.Message(mp.Type.ERROR, text=text))
         except (zmq.ZMQError, mp.ProtocolError):

@@ -23,7 +23,7 @@ add_test(NAME conformance_toy_solid_rollback
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 foreach(case "step;;result\\.echo" "abort;;abort\\.exit" "silent;;malformed\\.bad_magic\\.error"
              "role;;hello\\.text" "repeat;;iteration_unasked\\.error"
-             "norestore;--rollback;rollback\\.repeat")
+             "norestore;--rollback;rollback\\.repeat" "casekey;;case_key\\.error")
   list(GET case 0 bug)
   list(GET case 1 flag)
   list(GET case 2 pattern)
@@ -38,6 +38,7 @@ set_tests_properties(conformance_solid_mps conformance_solid_tlsph conformance_s
                      conformance_catches_bug_step conformance_catches_bug_abort
                      conformance_catches_bug_silent conformance_catches_bug_role
                      conformance_catches_bug_repeat conformance_catches_bug_norestore
+                     conformance_catches_bug_casekey
                      PROPERTIES TIMEOUT 60 LABELS integration ENVIRONMENT OMP_NUM_THREADS=1)
 
 # A solid that says it honours a moving tank (accepts CONFIG motion) but

@@ -20,6 +20,10 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
   duplicate_id    LOADS naming one id twice                    /  spec names none), exit
                                                                   status to match (section 8)
   unknown_key     CONFIG with a key the solver cannot know: ERROR "input: ...", exit 2
+  case_key        a case whose first body has rho = -2500, a key the solid owns (section 4:
+                  the coupler leaves the solid's keys to it): a case error, ERROR
+                  "input: case: CASE:LINE: solid.bodies.0.rho = -2500: problem" naming the
+                  case file and the line where the value is, then exit 2 (section 8)
   motion          CONFIG motion=constant, the case's tank held tilted by 30 degrees with
                   gravity on: the solid refuses (ERROR "input: ...", exit 2) or applies the
                   tilted gravity (its free plate falls towards -x, section 4)
@@ -99,6 +103,8 @@ MOTION_G, MOTION_ANGLE = 9.81, 30.0
 MOTION_SETS = ['motion.kind=constant', f'motion.angle={MOTION_ANGLE}', 'motion.pivot.x=0.0',
                'motion.pivot.y=0.0']
 EXIT_DEADLINE = 5.0     # s: a solver that has answered ERROR/BYE or got ABORT must be gone
+# A key every solid owns (the first body's density) with a value none accepts: scenario case_key
+BAD_KEY, BAD_VALUE = 'solid.bodies.0.rho', -2500
 ABORT_DEADLINE = 3.0    # s: "well within the coupler's grace time" (5 s)
 
 
@@ -381,10 +387,12 @@ class Suite:
         self.command = resolve_command(args.solid, args.build)
         self.case = os.path.join(self.tmp, 'case_resolved.yml')
         self.case_motion = os.path.join(self.tmp, 'case_motion.yml')
+        self.case_bad = os.path.join(self.tmp, 'case_bad_key.yml')
         try:
             self.dp = write_case(args.case, args.set, self.case)
             write_case(args.case, args.set + [f'gravity.y={-MOTION_G}'] + MOTION_SETS,
                        self.case_motion)
+            write_case(args.case, args.set + [f'{BAD_KEY}={BAD_VALUE}'], self.case_bad)
         except (OSError, KeyError, TypeError, ValueError, yaml.YAMLError) as e:
             shutil.rmtree(self.tmp, ignore_errors=True)
             sys.exit(f'conformance: case {args.case}: {type(e).__name__}: {e}')
@@ -788,6 +796,32 @@ class Suite:
                           text=self.config_text(s, 'conformance_no_such_key=1\n')))
         self.expect_error(s, 'config.unknown_key', 'input', 2)
 
+    def scenario_case_key(self, s):
+        """A wrong value of one of the solid's own keys (sections 4 and 8): a case error
+        naming the file, the line, the key and the value."""
+        self.hello(s)
+        s.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s, case=self.case_bad)))
+        frames, _ = s.recv(self.args.ready_timeout)
+        bad = ['no answer to CONFIG'] if frames is None else wire_problems(frames)
+        f = fields(frames) if not bad else {}
+        text = frames[-1].decode('utf-8', 'replace') if f and f['type'] == 9 and \
+            f['flags'] & 1 else ''
+        where = f'{self.case_bad}:{value_line(self.case_bad, BAD_KEY)}: {BAD_KEY} = {BAD_VALUE}'
+        line = mp.case_error(text)
+        if f and f['type'] != 9:
+            bad.append(f'{name_of(f["type"])} instead of ERROR')
+        elif f and line is None:
+            bad.append(f'ERROR {text[:100]!r} is not a case error "input: case: ..."')
+        elif f and not line.startswith(where + ': '):
+            bad.append(f'the case error {line[:160]!r} does not start with {where + ": "!r}')
+        self.check('case_key.error', not bad, '; '.join(bad) or repr(text[:160]))
+        rc = s.wait_exit(EXIT_DEADLINE)
+        late, _ = s.recv(0.05)
+        self.check('case_key.exit', rc == 2 and late is None,
+                   (f'still running {EXIT_DEADLINE:g} s later' if rc is None else
+                    f'exit status {rc}, expected 2') + ('; sent more after its ERROR'
+                                                         if late is not None else ''))
+
     def scenario_motion(self, s):
         """A moving tank (section 4): READY and the tilted gravity applied, or a refusal."""
         self.hello(s)
@@ -1009,8 +1043,8 @@ class Suite:
                    ('' if frames is None else '; a message got through'))
 
     SCENARIOS = ('run', 'abort', 'reject', 'bad_magic', 'truncated', 'wrong_version',
-                 'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'motion', 'timeout',
-                 'iteration_unasked', 'rollback', 'checkpoint', 'curve', 'curve_no_key')
+                 'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'case_key', 'motion',
+                 'timeout', 'iteration_unasked', 'rollback', 'checkpoint', 'curve', 'curve_no_key')
 
     def run(self):
         print(f'conformance: solid {" ".join(self.command)}, case {self.args.case}', flush=True)
@@ -1064,6 +1098,17 @@ def resolve_command(command, build):
     return words
 
 
+def value_line(path, key):
+    """The line (1-based) of key's value in the YAML file path."""
+    node = yaml.compose(open(path))
+    for part in key.split('.'):
+        if isinstance(node, yaml.SequenceNode):
+            node = node.value[int(part)]
+        else:
+            node = next(v for k, v in node.value if k.value == part)
+    return node.start_mark.line + 1
+
+
 def write_case(path, sets, dest):
     """The case as the coupler hands it over: overrides applied, here gravity 0."""
     with open(path) as f:
@@ -1073,8 +1118,8 @@ def write_case(path, sets, dest):
         key, _, value = kv.partition('=')
         node, parts = case, key.split('.')
         for p in parts[:-1]:
-            node = node.setdefault(p, {})
-        node[parts[-1]] = yaml.safe_load(value)
+            node = node[int(p)] if isinstance(node, list) else node.setdefault(p, {})
+        node[int(parts[-1]) if isinstance(node, list) else parts[-1]] = yaml.safe_load(value)
     with open(dest, 'w') as f:
         yaml.safe_dump(case, f, sort_keys=False)
     return float(case['dp'])

@@ -13,6 +13,8 @@ rule, so ctest can check that the suite catches it:
   --bug motion     accepts CONFIG motion=KIND (a moving tank) and ignores it
   --bug repeat     takes an ADVANCE of iteration > 0 as a new step, unasked
   --bug norestore  (with --rollback) repeats a step from where the last one ended
+  --bug casekey    answers a bad value of one of its keys (solid.bodies.0.rho) with a
+                   plain ERROR "input: ..." that names neither the key nor where it is
 
 usage: conformance_toy_solid.py [--rollback] [--bug NAME] --connect ENDPOINT
 """
@@ -54,6 +56,8 @@ def converse(sock):
     cfg = mp.recv(sock, 60000)
     if cfg.type == mp.Type.REJECT:
         return 1
+    if cfg.type == mp.Type.ABORT:
+        return 1
     if cfg.type != mp.Type.CONFIG:
         raise Fail(f'protocol: expected CONFIG, got {mp.Type(cfg.type).name}')
     conf = dict(line.split('=', 1) for line in cfg.text.splitlines() if line)
@@ -62,6 +66,11 @@ def converse(sock):
         ({'rollback'} if ROLLBACK else set()) - ({'motion'} if BUG == 'motion' else set())
     if unknown:
         raise Fail(f"input: CONFIG key '{sorted(unknown)[0]}' unknown")
+    # its one key of its own: the first body's density (PROTOCOL.md 8, case error)
+    try:
+        mp.Case(conf['case']).number('solid.bodies.0.rho', 1000.0, lo=0.0, lo_open=True)
+    except mp.CaseError as e:
+        raise Fail('input: ' + ('bad case' if BUG == 'casekey' else mp.CASE_ERROR + str(e)))
     with open(conf['case']) as f:
         x, fixed, surface, mass = particles(yaml.safe_load(f))
     n, v, force = len(x), np.zeros_like(x), np.zeros_like(x)

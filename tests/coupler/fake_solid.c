@@ -291,10 +291,10 @@ int main(int argc, char **argv)
      * (moving_frame 0) */
     static const struct proto_solver_ops ops = {"solid", "fake", configure, ready,
                                                 advance, finish,  save,      restore, 0,
-                                                NULL,    NULL};
+                                                NULL,    NULL,    NULL};
     static const struct proto_solver_ops ops_fixed = {"solid", "fake", configure,
                                                       ready,   advance, finish, NULL, NULL, 0,
-                                                      NULL,    NULL};
+                                                      NULL,    NULL,    NULL};
     enum mps_status st = proto_solver_run(endpoint, rollback ? &ops : &ops_fixed, &s, hello_ms,
                                           &stop_flag, &stats, &err);
     if (st)
