@@ -257,6 +257,23 @@ static int in_contact_set(const struct solid_mps *s, size_t i)
     return s->surface[i] || (s->nden && s->nden[i] < s->n0[i]);
 }
 
+/* Room for m particles in the contact set (their indices and positions). */
+static enum mps_status grow_contact_set(struct solid_mps_frac *f, size_t m, struct mps_err *err)
+{
+    if (m <= f->cap_m)
+        return MPS_OK;
+    size_t *si = realloc(f->sidx, m * sizeof *si);
+    if (si)
+        f->sidx = si;
+    double(*sx)[MPS_DIM] = realloc(f->sx, m * sizeof *sx);
+    if (sx)
+        f->sx = sx;
+    if (!si || !sx)
+        return mps_err_set(err, MPS_ENOMEM, "solid: no memory for %zu contact particles", m);
+    f->cap_m = m;
+    return MPS_OK;
+}
+
 /* Lists the pairs of the contact set closer than (1 + SKIN) l0 that may
  * touch: no intact bond between them, and of different bodies if
  * scene.contact says so. */
@@ -266,17 +283,9 @@ static enum mps_status build_pairs(struct solid_mps *s, struct mps_err *err)
     size_t m = 0;
     for (size_t i = 0; i < s->n; i++)
         m += in_contact_set(s, i);
-    if (m > f->cap_m) {
-        size_t *si = realloc(f->sidx, m * sizeof *si);
-        if (si)
-            f->sidx = si;
-        double(*sx)[MPS_DIM] = realloc(f->sx, m * sizeof *sx);
-        if (sx)
-            f->sx = sx;
-        if (!si || !sx)
-            return mps_err_set(err, MPS_ENOMEM, "solid: no memory for %zu contact particles", m);
-        f->cap_m = m;
-    }
+    enum mps_status st = grow_contact_set(f, m, err);
+    if (st)
+        return st;
     m = 0;
     for (size_t i = 0; i < s->n; i++)
         if (in_contact_set(s, i)) {
@@ -288,7 +297,7 @@ static enum mps_status build_pairs(struct solid_mps *s, struct mps_err *err)
     f->m = m;
     const double rad = (1.0 + SOLID_FRAC_SKIN) * s->dp;
     const double(*sx)[MPS_DIM] = (const double(*)[MPS_DIM])f->sx;
-    enum mps_status st = hgrid_build(&f->g, sx, m, rad, err);
+    st = hgrid_build(&f->g, sx, m, rad, err);
     if (st != MPS_OK)
         return st;
     struct pair_ctx ctx = {s, MPS_OK, err};
@@ -436,17 +445,8 @@ enum mps_status solid_mps_frac_get(struct solid_mps *s, struct mps_ckpt *c, stru
                            "%lld pairs, for %zu particles", (long long)sc.m, (long long)sc.np,
                            s->n);
     size_t m = (size_t)sc.m, np = (size_t)sc.np;
-    if (m > f->cap_m) {
-        size_t *si = realloc(f->sidx, m * sizeof *si);
-        if (si)
-            f->sidx = si;
-        double(*sx)[MPS_DIM] = realloc(f->sx, m * sizeof *sx);
-        if (sx)
-            f->sx = sx;
-        if (!si || !sx)
-            return mps_err_set(err, MPS_ENOMEM, "solid: no memory for %zu contact particles", m);
-        f->cap_m = m;
-    }
+    if ((st = grow_contact_set(f, m, err)))
+        return st;
     while (np > f->cap_p)
         if ((st = grow_pairs(f, err)))
             return st;
