@@ -66,6 +66,17 @@ static int path_index(struct reader *r, const struct frame *f)
 }
 
 /* Reader errors are fatal: returns the status after setting err. */
+/* A value of the frame f is complete: back to f's path, on to its next
+ * item (a sequence's next index, a mapping's next key). */
+static void next_item(struct reader *r, struct frame *f)
+{
+    case_sb_cut(&r->path, f->base);
+    if (f->seq)
+        f->idx++;
+    else
+        f->want_key = 1;
+}
+
 static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_err *err)
 {
     struct mps_case *c = r->c;
@@ -136,14 +147,8 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
         case YAML_MAPPING_END_EVENT:
         case YAML_SEQUENCE_END_EVENT:
             r->depth--;
-            if (r->depth) {
-                top = &r->st[r->depth - 1];
-                case_sb_cut(&r->path, top->base);
-                if (top->seq)
-                    top->idx++;
-                else
-                    top->want_key = 1;
-            }
+            if (r->depth)
+                next_item(r, &r->st[r->depth - 1]);
             break;
         case YAML_SCALAR_EVENT: {
             const char *s = (const char *)ev.data.scalar.value;
@@ -194,11 +199,7 @@ static enum mps_status read_yaml(struct reader *r, yaml_parser_t *p, struct mps_
                      CASE_MAX_KEYS);
             if (case_add_entry(c, key, s, sn, case_xprintf("%s:%d", file, line)))
                 NOMEM();
-            case_sb_cut(&r->path, top->base);
-            if (top->seq)
-                top->idx++;
-            else
-                top->want_key = 1;
+            next_item(r, top);
             break;
         }
         default:
