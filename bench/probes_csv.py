@@ -1,8 +1,21 @@
-"""Reading the CSV files the solvers write (probes.csv, the step logs): the
-'#' lines at the top are provenance (docs/output.md), the first other line
-holds the column names. One reader for the bench scripts and the checkers
-of tests/ (which put bench/ on their path)."""
+"""Reading what a run leaves (probes.csv and the step logs, whose '#' lines
+at the top are provenance and whose first other line holds the column
+names, docs/output.md; summary.json): one reader for the bench scripts and
+the checkers of tests/ (which put bench/ on their path)."""
+import json
+import os
+
 import numpy as np
+
+
+def finished(run, t_end):
+    """(summary.json of the run, None if it ran to t_end with status ok, else
+    one line saying why not)."""
+    with open(os.path.join(run, 'summary.json')) as f:
+        summ = json.load(f)
+    if summ.get('status') != 'ok' or summ.get('simulated_time', 0.0) < t_end - 1e-9:
+        return summ, f"run did not finish: status {summ.get('status')}: {summ.get('message')}"
+    return summ, None
 
 
 def csv_rows(path):

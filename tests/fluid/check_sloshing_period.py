@@ -21,7 +21,6 @@ level_left - level_right (tank frame, m) is fitted over the whole run with
     81% on the first mode (the rest on the odd higher ones).
 Exit 0 if all hold, 1 otherwise; prints what it measured."""
 import argparse
-import json
 import math
 import os
 import sys
@@ -29,7 +28,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
-from probes_csv import probes_table  # noqa: E402
+from probes_csv import finished, probes_table  # noqa: E402
 
 
 def fit(t, s, T0):
@@ -67,10 +66,9 @@ def main():
     ap.add_argument('--t-end', type=float, default=5.2)
     a = ap.parse_args()
     bad = []
-    with open(os.path.join(a.run, 'summary.json')) as f:
-        summ = json.load(f)
-    if summ.get('status') != 'ok' or summ.get('simulated_time', 0.0) < a.t_end - 1e-9:
-        bad.append(f"run did not finish: status {summ.get('status')}: {summ.get('message')}")
+    summ, why = finished(a.run, a.t_end)
+    if why:
+        bad.append(why)
     if summ.get('wall_guard_uses', 0) or summ.get('lost_particles', 0):
         bad.append(f"tank guard uses {summ.get('wall_guard_uses')}, lost "
                    f"{summ.get('lost_particles')}")

@@ -21,7 +21,6 @@ into the lab frame (x_lab = pivot + R(angle) (x - pivot)) and:
 Exit 0 if all hold, 1 otherwise; prints what it measured."""
 import argparse
 import glob
-import json
 import math
 import os
 import sys
@@ -30,7 +29,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
-from probes_csv import probes_table  # noqa: E402
+from probes_csv import finished, probes_table  # noqa: E402
 
 
 def main():
@@ -45,10 +44,9 @@ def main():
     ap.add_argument('--t-end', type=float, default=2.0)
     a = ap.parse_args()
     bad = []
-    with open(os.path.join(a.run, 'summary.json')) as f:
-        summ = json.load(f)
-    if summ.get('status') != 'ok' or summ.get('simulated_time', 0.0) < a.t_end - 1e-9:
-        bad.append(f"run did not finish: status {summ.get('status')}: {summ.get('message')}")
+    summ, why = finished(a.run, a.t_end)
+    if why:
+        bad.append(why)
     snaps = sorted(glob.glob(os.path.join(a.run, 'fluid_*.h5')))
     if not snaps:
         print('FAIL: no snapshot')
