@@ -122,9 +122,11 @@ int main(void)
     CHECK(coupling_iter_put(&run, &ck, &err) == MPS_OK);
     CHECK(coupling_iter_init(&back, &r1, 0.1, 1e-4, &err) == MPS_OK);
     CHECK(coupling_iter_get(&back, &ck, &err) == MPS_OK);
-    struct proto_msg send_b;
-    CHECK(coupling_iter_start(&run, &r1, dt, &send, &err) == MPS_OK);
-    CHECK(coupling_iter_start(&back, &r1, dt, &send_b, &err) == MPS_OK);
+    /* (the velocity reported at the restart, zero here, is not what the
+     * step's prediction takes: only the first step uses one) */
+    struct proto_msg send_b, r1s = state(x1, still);
+    CHECK(coupling_iter_start(&run, &r1s, dt, &send, &err) == MPS_OK);
+    CHECK(coupling_iter_start(&back, &r1s, dt, &send_b, &err) == MPS_OK);
     CHECK_NEAR(send.x[0][0], 0.02, 1e-15);
     CHECK(memcmp(send.x, send_b.x, sizeof x1) == 0 && memcmp(send.v, send_b.v, sizeof x1) == 0);
     CHECK(coupling_iter_result(&run, &r2, &conv, &err) == MPS_OK);
