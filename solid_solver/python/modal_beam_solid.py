@@ -34,7 +34,7 @@ restart=N (or 0); with restart=N in CONFIG it starts from checkpoint N.
 
 usage: modal_beam_solid.py [--courant C] [--key FILE] --connect ENDPOINT
 """
-import json, math, os, sys, time
+import hashlib, json, math, os, sys, time
 
 import h5py
 import numpy as np
@@ -209,7 +209,9 @@ class Snapshots:
 
 class Checkpoints:
     """OUT/checkpoint/PREFIX_NNNNNN.ckpt: the beam's whole state (q, q') with
-    the step count and the snapshot index (the series continues from it)."""
+    the step count and the snapshot index (the series continues from it), as
+    JSON after a line with its SHA-256: a damaged file is refused, not read as
+    another state (the C solvers' checkpoints carry a hash too)."""
 
     def __init__(self, out, prefix):
         self.dir, self.prefix = os.path.join(out, 'checkpoint'), prefix
@@ -223,8 +225,9 @@ class Checkpoints:
         path = self.path(number)
         try:
             os.makedirs(self.dir, exist_ok=True)
-            with open(path + '.tmp', 'w') as f:
-                json.dump(state, f)
+            body = json.dumps(state)
+            with open(path + '.tmp', 'w') as f:  # the body's SHA-256 on the first line
+                f.write(hashlib.sha256(body.encode()).hexdigest() + '\n' + body)
                 f.flush()
                 os.fsync(f.fileno())
             os.replace(path + '.tmp', path)  # a kill while writing leaves the last ones
@@ -240,7 +243,10 @@ class Checkpoints:
         path = self.path(number)
         try:
             with open(path) as f:
-                state = json.load(f)
+                digest, _, body = f.read().partition('\n')
+            if hashlib.sha256(body.encode()).hexdigest() != digest:
+                raise ValueError('checkpoint damaged (SHA-256 mismatch)')
+            state = json.loads(body)
             beam.q, beam.qd = float.fromhex(state['q']), float.fromhex(state['qd'])
             return int(state['step']), list(state['grids'])
         except (OSError, KeyError, TypeError, ValueError) as e:

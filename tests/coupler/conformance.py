@@ -40,7 +40,10 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
                   process with CONFIG restart=1 in the same out directory: its READY must
                   be step 1's RESULT state bit for bit and its step 2 with loads B step 2's
                   RESULT bit for bit (section 6, "Checkpoints"); a third with restart=9
-                  (never written): ERROR "input: ...", exit 2
+                  (never written): ERROR "input: ...", exit 2; a fourth with restart=1
+                  after one digit of OUT/checkpoint/*_000001.ckpt was changed (where
+                  our solvers keep it; not checked if there is none): ERROR "input:
+                  ...", exit 2
   curve           on tcp with CURVE (section 10): the key file reaches the solver
                   as the coupler passes it (MPS_COUPLING_KEY); HELLO, READY, one
                   ADVANCE, STOP/BYE, exit 0, authenticated with the issued key
@@ -68,6 +71,7 @@ the mark is removed once the solver is fixed.
 """
 import argparse
 import fnmatch
+import glob
 import json
 import math
 import os
@@ -1013,6 +1017,39 @@ class Suite:
             pass
         finally:
             s3.close()
+        self.checkpoint_damaged(s.out)
+
+    def checkpoint_damaged(self, out):
+        """A checkpoint changed on disk (one digit) must be refused as an input
+        error, not read as another state. Where a solver keeps its checkpoints
+        is its own business (PROTOCOL.md 6): this looks for ours,
+        OUT/checkpoint/*_000001.ckpt, and says so when there is none."""
+        files = sorted(glob.glob(os.path.join(out, 'checkpoint', '*_000001.ckpt')))
+        if not files:
+            print('INFO  checkpoint.damaged: no OUT/checkpoint/*_000001.ckpt (the solver keeps '
+                  'its checkpoints elsewhere): not checked')
+            return
+        with open(files[0], 'rb') as f:
+            data = bytearray(f.read())
+        # the first decimal digit from the middle on: changed, a JSON or a
+        # binary file stays readable as a file of that format
+        k = next((i for i in range(len(data) // 2, len(data)) if 48 <= data[i] <= 57), None)
+        if k is None:
+            print('INFO  checkpoint.damaged: no digit in the second half of the file: not checked')
+            return
+        data[k] = 49 if data[k] != 49 else 50
+        with open(files[0], 'wb') as f:
+            f.write(data)
+        s4 = Session(self, 'checkpoint_damaged')
+        s4.out = out
+        try:
+            self.hello(s4)
+            s4.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s4, 'restart=1\n')))
+            self.expect_error(s4, 'checkpoint.damaged', 'input', 2)
+        except Stop:
+            pass
+        finally:
+            s4.close()
 
     def scenario_curve(self, s):
         """Section 10: a whole short conversation over tcp with CURVE."""

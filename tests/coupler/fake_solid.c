@@ -106,9 +106,9 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     enum mps_status st = mps_case_load(&c, case_path, NULL, 0, tables, 2, ignore, err);
     if (!st)
         st = solid_scene_read(&s->scene, c, err);
-    if (st) {
+    if (st) { /* a problem with its keys is a case error (PROTOCOL.md 4, 8) */
         mps_case_destroy(&c);
-        return st;
+        return proto_solver_case_error(st, err);
     }
     s->dp = mps_case_double(c, "dp");
     double b[4] = {mps_case_double(c, "solid.bodies.0.x0"), mps_case_double(c, "solid.bodies.0.y0"),
@@ -297,7 +297,7 @@ int main(int argc, char **argv)
                                                       NULL,    NULL,    NULL};
     enum mps_status st = proto_solver_run(endpoint, rollback ? &ops : &ops_fixed, &s, hello_ms,
                                           &stop_flag, &stats, &err);
-    if (st)
+    if (st && !stats.coupler_reports) /* else the coupler said it, as the solvers do */
         fprintf(stderr, "fake_solid: %s: %s\n", mps_status_name(st), err.msg);
     free(s.id);
     free(s.x0);

@@ -338,6 +338,19 @@ def t_solver_input_error():
           f'{err.strip()[:300]!r}')
 
 
+def t_fake_case_error():
+    """A solid of another make (the fake) with a problem in its own keys
+    answers a case error (PROTOCOL.md 4, 8): the user sees one line, the
+    coupler's, naming the key, and exit status 2, as with our solvers."""
+    out = tempfile.mkdtemp(prefix='cpl_fkcase_')
+    rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                   '--set', 'solid.poisson=0.7'])
+    lines = [l for l in err.splitlines() if l.strip()]
+    check(rc == 2, f'exit status {rc} (expected 2: an input error)')
+    check(len(lines) == 1 and lines[0].startswith('coupler: ') and 'solid.poisson' in lines[0],
+          f'one line, the coupler\'s, naming the key: {err.strip()[:300]!r}')
+
+
 def t_summary_unwritable():
     """A run whose record cannot be written does not end as a success: with
     OUT/solid_summary.json taken by a directory, the coupler names the file
