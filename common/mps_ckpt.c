@@ -102,6 +102,28 @@ enum mps_status mps_ckpt_get_any(struct mps_ckpt *c, const char *name, const voi
     return MPS_OK;
 }
 
+int mps_ckpt_has(const struct mps_ckpt *c, const char *name)
+{
+    const size_t nl = strlen(name);
+    size_t pos = 0;
+    /* the walk of mps_ckpt_get_any, without its checks of the name */
+    while (pos + sizeof(uint16_t) <= c->len) {
+        uint16_t n16;
+        uint64_t b64;
+        memcpy(&n16, c->buf + pos, sizeof n16);
+        size_t head = pad8(sizeof n16 + n16);
+        if (pos + head + sizeof b64 > c->len)
+            return 0; /* damaged: reading it will say so */
+        if (n16 == nl && memcmp(c->buf + pos + sizeof n16, name, nl) == 0)
+            return 1;
+        memcpy(&b64, c->buf + pos + head, sizeof b64);
+        if (b64 > c->len - (pos + head + sizeof b64))
+            return 0;
+        pos += head + sizeof b64 + pad8((size_t)b64);
+    }
+    return 0;
+}
+
 enum mps_status mps_ckpt_get(struct mps_ckpt *c, const char *name, void *data, size_t bytes,
                              struct mps_err *err)
 {

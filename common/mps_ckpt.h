@@ -52,6 +52,11 @@ enum mps_status mps_ckpt_get(struct mps_ckpt *c, const char *name, void *data, s
 enum mps_status mps_ckpt_get_any(struct mps_ckpt *c, const char *name, const void **data,
                                  size_t *bytes, struct mps_err *err);
 
+/* 1 if the image holds a block called name (anywhere; the read position
+ * does not move), 0 if not: a section a newer version adds, asked before it
+ * is needed. */
+int mps_ckpt_has(const struct mps_ckpt *c, const char *name);
+
 /* DIR/checkpoint/PREFIX_NNNNNN.ckpt into path (size len). */
 void mps_ckpt_path(char *path, size_t len, const char *dir, const char *prefix, long number);
 

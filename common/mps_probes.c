@@ -94,6 +94,24 @@ long mps_probes_bytes(const struct mps_probes *p)
     return p ? ftell(p->f) : 0;
 }
 
+enum mps_status mps_table_continue(FILE **f, const char *path, long bytes, struct mps_err *err)
+{
+    struct stat sb;
+    *f = NULL;
+    if (stat(path, &sb) != 0 || sb.st_size < bytes)
+        return mps_err_set(err, MPS_EINPUT, "%s: %s than the checkpoint's %ld bytes: not the "
+                           "file the checkpoint was written with", path,
+                           stat(path, &sb) != 0 ? "missing, shorter" : "shorter", bytes);
+    if (truncate(path, bytes) != 0 || !(*f = fopen(path, "a")) || fseek(*f, 0, SEEK_END) != 0) {
+        int e = errno;
+        if (*f)
+            fclose(*f);
+        *f = NULL;
+        return mps_err_set(err, MPS_EIO, "cannot continue '%s': %s", path, strerror(e));
+    }
+    return MPS_OK;
+}
+
 enum mps_status mps_probes_resume(struct mps_probes **out, const char *path, long bytes, int n,
                                   struct mps_err *err)
 {
@@ -103,15 +121,7 @@ enum mps_status mps_probes_resume(struct mps_probes **out, const char *path, lon
         return st;
     p = *out;
     *out = NULL;
-    struct stat sb;
-    if (stat(path, &sb) != 0 || sb.st_size < bytes)
-        st = mps_err_set(err, MPS_EINPUT, "%s: %s than the checkpoint's %ld bytes: not the file "
-                         "the checkpoint was written with", path,
-                         stat(path, &sb) != 0 ? "missing, shorter" : "shorter", bytes);
-    else if (truncate(path, bytes) != 0 || !(p->f = fopen(path, "a")) ||
-             fseek(p->f, 0, SEEK_END) != 0)
-        st = mps_err_set(err, MPS_EIO, "cannot continue '%s': %s", path, strerror(errno));
-    if (st) {
+    if ((st = mps_table_continue(&p->f, path, bytes, err))) {
         mps_probes_close(&p);
         return st;
     }

@@ -6,6 +6,8 @@
 #ifndef MPS_PROBES_H
 #define MPS_PROBES_H
 
+#include <stdio.h>
+
 #include "mps_err.h"
 
 struct mps_probes;
@@ -23,5 +25,11 @@ long mps_probes_bytes(const struct mps_probes *p);
 enum mps_status mps_probes_resume(struct mps_probes **out, const char *path, long bytes, int n,
                                   struct mps_err *err);
 void mps_probes_close(struct mps_probes **p);
+
+/* Any csv table a restart continues (probes.csv, the coupler's
+ * iterations.csv): cuts path to its first bytes (its length at the
+ * checkpoint) and opens it for appending into *f. MPS_EINPUT if the file is
+ * missing or shorter (not the one the checkpoint was written with). */
+enum mps_status mps_table_continue(FILE **f, const char *path, long bytes, struct mps_err *err);
 
 #endif

@@ -718,6 +718,60 @@ struct coupler_scalars {
     int64_t step;
 };
 
+/* Implicit coupling's counters: summary.json's "iterations" and the probe
+ * column coupling_iterations (a mean since the last row, which a checkpoint
+ * may fall inside). */
+struct implicit_counters {
+    int64_t iterations, iter_max, limit_hits, hist[8], probe_sum, probe_steps;
+    double change_max;
+};
+_Static_assert(sizeof ((struct coupler *)0)->iter_hist == 8 * sizeof(long), "histogram bins");
+
+/* Implicit coupling's history, after the coupler's scalars: the counters,
+ * the interface iteration's (coupling_iter_put: the displacement reference,
+ * the predictor) and the acceleration's (coupling_accel_put: Aitken's
+ * factor, IQN-ILS's reused columns). Without it the next steps would start
+ * from another predictor and factor or without the columns: the same
+ * physics within the tolerance, not the same bits. */
+static enum mps_status put_implicit(const struct coupler *c, struct mps_ckpt *ck,
+                                    struct mps_err *err)
+{
+    struct implicit_counters ic;
+    memset(&ic, 0, sizeof ic);
+    ic.iterations = c->iterations;
+    ic.iter_max = c->iter_max;
+    ic.limit_hits = c->limit_hits;
+    for (int b = 0; b < 8; b++)
+        ic.hist[b] = c->iter_hist[b];
+    ic.probe_sum = c->iter_probe_sum;
+    ic.probe_steps = c->iter_probe_steps;
+    ic.change_max = c->change_max;
+    enum mps_status st;
+    if ((st = mps_ckpt_put(ck, "implicit", &ic, sizeof ic, err)) ||
+        (st = coupling_iter_put(&c->iter, ck, err)))
+        return st;
+    return coupling_accel_put(c->accel, ck, err);
+}
+
+static enum mps_status get_implicit(struct coupler *c, struct mps_err *err)
+{
+    struct implicit_counters ic;
+    enum mps_status st;
+    if ((st = mps_ckpt_get(&c->disk, "implicit", &ic, sizeof ic, err)) ||
+        (st = coupling_iter_get(&c->iter, &c->disk, err)) ||
+        (st = coupling_accel_get(c->accel, &c->disk, err)))
+        return mps_err_prefix(err, "%s: ", c->restart_path);
+    c->iterations = (long)ic.iterations;
+    c->iter_max = (int)ic.iter_max;
+    c->limit_hits = (long)ic.limit_hits;
+    for (int b = 0; b < 8; b++)
+        c->iter_hist[b] = (long)ic.hist[b];
+    c->iter_probe_sum = (long)ic.probe_sum;
+    c->iter_probe_steps = (long)ic.probe_steps;
+    c->change_max = ic.change_max;
+    return MPS_OK;
+}
+
 static enum mps_status put_coupler(const void *self, struct mps_ckpt *ck, struct mps_err *err)
 {
     const struct coupler *c = self;
@@ -730,7 +784,8 @@ static enum mps_status put_coupler(const void *self, struct mps_ckpt *ck, struct
         sc.dt[k] = c->p[k].dt;
     for (int a = 0; a < MPS_DIM; a++)
         sc.impulse[a] = c->impulse[a];
-    return mps_ckpt_put(ck, "coupler", &sc, sizeof sc, err);
+    enum mps_status st = mps_ckpt_put(ck, "coupler", &sc, sizeof sc, err);
+    return st || !c->implicit ? st : put_implicit(c, ck, err);
 }
 
 static enum mps_status get_coupler(struct coupler *c, struct mps_err *err)
@@ -746,7 +801,7 @@ static enum mps_status get_coupler(struct coupler *c, struct mps_err *err)
         c->p[k].dt = sc.dt[k];
     for (int a = 0; a < MPS_DIM; a++)
         c->impulse[a] = sc.impulse[a];
-    return MPS_OK;
+    return c->implicit ? get_implicit(c, err) : MPS_OK;
 }
 
 /* The coupler's part of checkpoint number ++mark.number, written after the
@@ -757,6 +812,13 @@ static enum mps_status write_checkpoint(struct coupler *c, struct mps_err *err)
     c->mark.number++;
     c->mark.steps = c->step;
     c->mark.table_bytes[0] = mps_probes_bytes(c->probes);
+    /* iterations.csv is cut there at a restart, as probes.csv is */
+    if (c->iter_log) {
+        if (fflush(c->iter_log) != 0)
+            return mps_err_set(err, MPS_EIO, "%s/iterations.csv: cannot write: %s", c->out,
+                               strerror(errno));
+        c->mark.table_bytes[1] = ftell(c->iter_log);
+    }
     enum mps_status st = mps_run_checkpoint(&c->disk, c->out, "coupler", c->case_yaml, &c->mark,
                                             NULL, c->time, put_coupler, c, err);
     c->checkpoints += st == MPS_OK;
@@ -1233,18 +1295,15 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
                              "implicit coupling needs a fluid and a solid");
     c->ck_interval = mps_case_double(c->cs, "output.checkpoint_interval");
     c->ck_asked = strcmp(mps_case_where(c->cs, "output.checkpoint_interval"), "default") != 0;
-    /* the implicit scheme's history (the predictor, the acceleration's
-     * columns and factor, the displacement reference) is not in the
-     * checkpoints: refused when asked, off by default (docs/restart.md) */
-    if (c->implicit && (c->restart || (c->ck_interval > 0.0 && c->ck_asked)))
-        return mps_case_fail(c->cs, err, "coupling.scheme",
-                             "checkpoints and restarts of implicit coupling are not "
-                             "implemented (its iteration history is not saved): set "
-                             "output.checkpoint_interval: 0, or coupling.scheme: explicit");
-    if (c->implicit && c->ck_interval > 0.0) {
-        c->ck_interval = 0.0;
-        c->ck_note = "off: implicit coupling is not checkpointed";
-    }
+    /* versioning: the implicit scheme's history is a section of its own
+     * (get_implicit), which builds before it did not write: refused before
+     * anything is launched */
+    if (c->implicit && c->restart && !mps_ckpt_has(&c->disk, "implicit"))
+        return mps_err_set(err, MPS_EINPUT,
+                           "%s: holds no history of the implicit coupling (section 'implicit': "
+                           "written by a build that did not checkpoint implicit runs); it cannot "
+                           "continue this implicit run bit for bit: run it again from the start",
+                           c->restart_path);
     return MPS_OK;
 }
 
@@ -1328,13 +1387,18 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
     if (c->implicit && mps_case_bool(c->cs, "coupling.implicit.log")) {
         char path[4200];
         snprintf(path, sizeof path, "%s/iterations.csv", c->out);
-        if (!(c->iter_log = fopen(path, "w")))
+        if (c->restart) { /* where it stood at the checkpoint (write_checkpoint) */
+            if ((st = mps_table_continue(&c->iter_log, path, c->mark.table_bytes[1], err)))
+                return st;
+        } else if (!(c->iter_log = fopen(path, "w"))) {
             return mps_err_set(err, MPS_EIO, "cannot create %s: %s", path, strerror(errno));
-        /* factor: the relaxation factor (constant, aitken) or the columns
-         * (iqn_ils) that chose the next iterate; 0 on the step's last */
-        fputs("step,time,iteration,change_rms_m,step_displacement_rms_m,displacement_rms_m,"
-              "factor\n",
-              c->iter_log);
+        } else {
+            /* factor: the relaxation factor (constant, aitken) or the columns
+             * (iqn_ils) that chose the next iterate; 0 on the step's last */
+            fputs("step,time,iteration,change_rms_m,step_displacement_rms_m,displacement_rms_m,"
+                  "factor\n",
+                  c->iter_log);
+        }
     }
     if (!c->quiet)
         fprintf(stderr, "coupler: %s%s%s, output in %s\n", c->p[FLUID].needed ? "fluid" : "",

@@ -1,6 +1,8 @@
 #include "coupling_accel.h"
 
 #include <math.h>
+#include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -271,6 +273,31 @@ void coupling_accel_destroy(struct coupling_accel **pa)
     *pa = NULL;
 }
 
+/* Vectors for length n > 0 (past columns dropped). */
+static enum mps_status alloc_vectors(struct coupling_accel *a, size_t n, struct mps_err *err)
+{
+    free_vectors(a);
+    size_t cols = a->scheme->end == iqn_end ? IQN_MAX_COLS : 0;
+    a->r = malloc(n * sizeof *a->r);
+    a->r_prev = malloc(n * sizeof *a->r_prev);
+    a->out_prev = malloc(n * sizeof *a->out_prev);
+    if (cols) {
+        a->V = malloc(cols * n * sizeof *a->V);
+        a->W = malloc(cols * n * sizeof *a->W);
+        a->Q = malloc(cols * n * sizeof *a->Q);
+        a->R = malloc(cols * cols * sizeof *a->R);
+        a->c = malloc(cols * sizeof *a->c);
+        a->age = malloc(cols * sizeof *a->age);
+    }
+    if (!a->r || !a->r_prev || !a->out_prev ||
+        (cols && (!a->V || !a->W || !a->Q || !a->R || !a->c || !a->age))) {
+        free_vectors(a);
+        return mps_err_set(err, MPS_ENOMEM, "coupling acceleration: out of memory for %zu", n);
+    }
+    a->n = n;
+    return MPS_OK;
+}
+
 enum mps_status coupling_accel_begin(struct coupling_accel *a, size_t n, struct mps_err *err)
 {
     if (n == 0)
@@ -286,25 +313,70 @@ enum mps_status coupling_accel_begin(struct coupling_accel *a, size_t n, struct 
         a->omega = a->omega0;
     if (n == a->n && a->r)
         return MPS_OK;
-    free_vectors(a); /* a new interface size: past columns mean nothing */
-    size_t m = n ? n : 1, cols = a->scheme->end == iqn_end ? IQN_MAX_COLS : 0;
-    a->r = malloc(m * sizeof *a->r);
-    a->r_prev = malloc(m * sizeof *a->r_prev);
-    a->out_prev = malloc(m * sizeof *a->out_prev);
-    if (cols) {
-        a->V = malloc(cols * m * sizeof *a->V);
-        a->W = malloc(cols * m * sizeof *a->W);
-        a->Q = malloc(cols * m * sizeof *a->Q);
-        a->R = malloc(cols * cols * sizeof *a->R);
-        a->c = malloc(cols * sizeof *a->c);
-        a->age = malloc(cols * sizeof *a->age);
-    }
-    if (!a->r || !a->r_prev || !a->out_prev ||
-        (cols && (!a->V || !a->W || !a->Q || !a->R || !a->c || !a->age))) {
-        free_vectors(a);
-        return mps_err_set(err, MPS_ENOMEM, "coupling acceleration: out of memory for %zu", n);
-    }
-    a->n = n;
+    return alloc_vectors(a, n, err); /* a new interface size: past columns mean nothing */
+}
+
+/* The checkpoint's fixed part (coupling_accel_put). */
+struct accel_head {
+    char scheme[16];
+    double omega0, omega, filter, last;
+    int64_t reuse, n, ncols;
+};
+
+enum mps_status coupling_accel_put(const struct coupling_accel *a, struct mps_ckpt *ck,
+                                   struct mps_err *err)
+{
+    struct accel_head h;
+    memset(&h, 0, sizeof h);
+    snprintf(h.scheme, sizeof h.scheme, "%s", a->scheme->name);
+    h.omega0 = a->omega0;
+    h.omega = a->omega;
+    h.filter = a->filter;
+    h.last = a->last;
+    h.reuse = a->reuse;
+    h.n = (int64_t)a->n;
+    h.ncols = a->ncols;
+    const size_t cols = (size_t)a->ncols;
+    enum mps_status st;
+    if ((st = mps_ckpt_put(ck, "accel", &h, sizeof h, err)) ||
+        (st = mps_ckpt_put(ck, "accel.age", a->age, cols * sizeof *a->age, err)) ||
+        (st = mps_ckpt_put(ck, "accel.V", a->V, cols * a->n * sizeof *a->V, err)))
+        return st;
+    return mps_ckpt_put(ck, "accel.W", a->W, cols * a->n * sizeof *a->W, err);
+}
+
+enum mps_status coupling_accel_get(struct coupling_accel *a, struct mps_ckpt *ck,
+                                   struct mps_err *err)
+{
+    struct accel_head h;
+    enum mps_status st = mps_ckpt_get(ck, "accel", &h, sizeof h, err);
+    if (st)
+        return st;
+    h.scheme[sizeof h.scheme - 1] = '\0';
+    if (strcmp(h.scheme, a->scheme->name) || h.omega0 != a->omega0 || h.reuse != a->reuse ||
+        h.filter != a->filter)
+        return mps_err_set(err, MPS_EINPUT,
+                           "checkpoint: coupling acceleration %s (relaxation %g, reuse %lld, "
+                           "filter %g), this run has %s (%g, %d, %g)",
+                           h.scheme, h.omega0, (long long)h.reuse, h.filter, a->scheme->name,
+                           a->omega0, a->reuse, a->filter);
+    if (h.n < 0 || h.ncols < 0 || h.ncols > (a->scheme->end == iqn_end ? IQN_MAX_COLS : 0) ||
+        (h.ncols > 0 && h.n == 0))
+        return mps_err_set(err, MPS_EINPUT,
+                           "checkpoint: coupling acceleration with %lld columns of %lld: damaged",
+                           (long long)h.ncols, (long long)h.n);
+    free_vectors(a);
+    if (h.n > 0 && (st = alloc_vectors(a, (size_t)h.n, err)))
+        return st;
+    const size_t cols = (size_t)h.ncols;
+    if ((st = mps_ckpt_get(ck, "accel.age", a->age, cols * sizeof *a->age, err)) ||
+        (st = mps_ckpt_get(ck, "accel.V", a->V, cols * a->n * sizeof *a->V, err)) ||
+        (st = mps_ckpt_get(ck, "accel.W", a->W, cols * a->n * sizeof *a->W, err)))
+        return st;
+    a->ncols = (int)h.ncols;
+    a->omega = h.omega;
+    a->last = h.last;
+    a->k = 0;
     return MPS_OK;
 }
 

@@ -25,6 +25,7 @@
 
 #include <stddef.h>
 
+#include "mps_ckpt.h"
 #include "mps_err.h"
 
 struct coupling_accel;
@@ -56,6 +57,18 @@ enum mps_status coupling_accel_next(struct coupling_accel *a, const double *in,
 /* The step ended (converged or accepted): iqn_ils keeps its columns for the
  * next `reuse` steps. */
 void coupling_accel_end(struct coupling_accel *a);
+
+/* Between steps (after coupling_accel_end), what the next steps depend on,
+ * as checkpoint blocks "accel" (scheme, parameters, Aitken's factor in use,
+ * vector length), "accel.age", "accel.V", "accel.W" (iqn_ils's kept
+ * columns: variable size, empty for the other schemes). get reads them into
+ * an accel created with the same scheme and parameters (MPS_EINPUT naming
+ * the one that differs); the next step then chooses what it would have
+ * chosen without the checkpoint, bit for bit (docs/restart.md). */
+enum mps_status coupling_accel_put(const struct coupling_accel *a, struct mps_ckpt *ck,
+                                   struct mps_err *err);
+enum mps_status coupling_accel_get(struct coupling_accel *a, struct mps_ckpt *ck,
+                                   struct mps_err *err);
 
 /* The relaxation factor of the last update (constant, aitken); for iqn_ils
  * the number of columns it used. For summaries. */

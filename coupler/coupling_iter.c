@@ -1,6 +1,7 @@
 #include "coupling_iter.h"
 
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -182,5 +183,50 @@ enum mps_status coupling_iter_relax(struct coupling_iter *it, struct coupling_ac
     it->in = it->next;
     it->next = t;
     unpack(it, it->in, send);
+    return MPS_OK;
+}
+
+/* The checkpoint's fixed part (coupling_iter_put). */
+struct iter_head {
+    int64_t n;
+    double dt_prev;
+};
+
+enum mps_status coupling_iter_put(const struct coupling_iter *it, struct mps_ckpt *ck,
+                                  struct mps_err *err)
+{
+    struct iter_head h;
+    memset(&h, 0, sizeof h);
+    h.n = (int64_t)it->n;
+    h.dt_prev = it->dt_prev;
+    enum mps_status st;
+    if ((st = mps_ckpt_put(ck, "iter", &h, sizeof h, err)) ||
+        (st = mps_ckpt_put(ck, "iter.id", it->id, it->n * sizeof *it->id, err)) ||
+        (st = mps_ckpt_put(ck, "iter.x0", it->x0, it->n * sizeof *it->x0, err)))
+        return st;
+    return mps_ckpt_put(ck, "iter.x_prev", it->x_prev, it->n * sizeof *it->x_prev, err);
+}
+
+enum mps_status coupling_iter_get(struct coupling_iter *it, struct mps_ckpt *ck,
+                                  struct mps_err *err)
+{
+    struct iter_head h;
+    const void *ids;
+    size_t bytes;
+    enum mps_status st;
+    if ((st = mps_ckpt_get(ck, "iter", &h, sizeof h, err)) ||
+        (st = mps_ckpt_get_any(ck, "iter.id", &ids, &bytes, err)))
+        return st;
+    if (h.n != (int64_t)it->n || bytes != it->n * sizeof *it->id ||
+        (it->n && memcmp(ids, it->id, bytes) != 0))
+        return mps_err_set(err, MPS_EINPUT,
+                           "checkpoint: the implicit coupling's interface had %lld particles, the "
+                           "restarted solid reports %zu%s",
+                           (long long)h.n, it->n,
+                           h.n == (int64_t)it->n ? " in another order or with other ids" : "");
+    if ((st = mps_ckpt_get(ck, "iter.x0", it->x0, it->n * sizeof *it->x0, err)) ||
+        (st = mps_ckpt_get(ck, "iter.x_prev", it->x_prev, it->n * sizeof *it->x_prev, err)))
+        return st;
+    it->dt_prev = h.dt_prev;
     return MPS_OK;
 }

@@ -32,6 +32,7 @@
 #include <stddef.h>
 
 #include "coupling_accel.h"
+#include "mps_ckpt.h"
 #include "mps_dim.h"
 #include "mps_err.h"
 #include "proto_msg.h"
@@ -81,6 +82,17 @@ enum mps_status coupling_iter_relax(struct coupling_iter *it, struct coupling_ac
  * 1 (the coupler repeats it, which gives that iteration's answer again, bit
  * for bit, and accepts it); 0 if the last was the best. */
 int coupling_iter_best(struct coupling_iter *it, struct proto_msg *send);
+
+/* Between steps, what the next steps depend on, as checkpoint blocks
+ * "iter" (particles, the last step's length), "iter.id", "iter.x0" (the
+ * displacement reference: after a restart READY reports the positions then,
+ * not the initial ones) and "iter.x_prev" (the predictor's last step start).
+ * get reads them into it after coupling_iter_init from the restarted
+ * solid's READY, which must list the same interface (MPS_EINPUT if not). */
+enum mps_status coupling_iter_put(const struct coupling_iter *it, struct mps_ckpt *ck,
+                                  struct mps_err *err);
+enum mps_status coupling_iter_get(struct coupling_iter *it, struct mps_ckpt *ck,
+                                  struct mps_err *err);
 
 /* Vector length, for coupling_accel_begin. */
 size_t coupling_iter_len(const struct coupling_iter *it);

@@ -378,9 +378,13 @@ static enum mps_status peer_checkpoint(void *self, long number, double time,
                                        struct mps_err *err)
 {
     struct run *r = self;
+    /* a repeated iteration (implicit coupling) rewrites checkpoint number */
+    const int again = r->checkpoints > 0 && r->mark.number == number;
     r->mark.number = number - 1; /* write_checkpoint counts it */
     (void)time;                  /* the fluid's own time is the coupler's (peer_advance) */
-    return write_checkpoint(r, err);
+    enum mps_status st = write_checkpoint(r, err);
+    r->checkpoints -= again && !st;
+    return st;
 }
 
 static enum mps_status peer_resume(void *self, long number, struct mps_err *err)

@@ -11,9 +11,11 @@ rows of probes.csv between HALF and STOP must be replaced, not repeated.
 With --kill instead of STOP ("kill"), the cut run is killed with SIGKILL as
 soon as a checkpoint at or after HALF exists, and restarted from its latest.
 A third run without checkpoints (output.checkpoint_interval=0) must give
-the same probes.csv rows as the first. Then every data row of probes.csv, every snapshot's particle fields and
+the same probes.csv rows (and iterations.csv, if the run writes one) as the first. Then every data row of probes.csv, every snapshot's particle fields and
 time/step attributes, and the XDMF indexes must be identical between
-OUT/full and OUT/cut; the restart's summary.json must say where it restarted.
+OUT/full and OUT/cut, and so must iterations.csv and the iteration counts
+of summary.json (implicit coupling); the restart's summary.json must say
+where it restarted.
 --require COLUMN: the column must be > 0 at the checkpoint restarted from
 (e.g. broken_bonds: the checkpoint holds a fractured solid).
 Exit 0 if all hold, 1 with the first difference otherwise."""
@@ -45,6 +47,14 @@ def run(cmd, **kw):
 def rows(path):
     with open(path) as f:
         return [ln for ln in f if not ln.startswith("#")]
+
+
+def same_rows(name, ra, rb):
+    if ra != rb:
+        n = next((k for k, (x, y) in enumerate(zip(ra, rb)) if x != y), min(len(ra), len(rb)))
+        fail("%s: %d rows against %d, first difference at data row %d:\n  %s  %s"
+             % (name, len(ra), len(rb), n, ra[n] if n < len(ra) else "(none)\n",
+                rb[n] if n < len(rb) else "(none)"))
 
 
 def ckpt_time(path):
@@ -139,11 +149,23 @@ def main():
     if rows(os.path.join(full, "probes.csv")) != rows(os.path.join(nock, "probes.csv")):
         fail("probes.csv differs between the run with checkpoints and the run without")
     ra, rb = rows(os.path.join(full, "probes.csv")), rows(os.path.join(cut, "probes.csv"))
-    if ra != rb:
-        n = next((k for k, (x, y) in enumerate(zip(ra, rb)) if x != y), min(len(ra), len(rb)))
-        fail("probes.csv: %d rows against %d, first difference at data row %d:\n  %s  %s"
-             % (len(ra), len(rb), n, ra[n] if n < len(ra) else "(none)\n",
-                rb[n] if n < len(rb) else "(none)"))
+    same_rows("probes.csv", ra, rb)
+    # implicit coupling: its log (coupling.implicit.log) and its counters
+    iters = os.path.join(full, "iterations.csv")
+    if os.path.exists(iters):
+        ia = rows(iters)
+        if ia != rows(os.path.join(nock, "iterations.csv")):
+            fail("iterations.csv differs between the run with checkpoints and the run without")
+        same_rows("iterations.csv", ia, rows(os.path.join(cut, "iterations.csv")))
+        print("iterations.csv: %d rows identical" % (len(ia) - 1))
+    # (the coupler's summary; a solver alone has none)
+    with open(os.path.join(full, "summary.json")) as f:
+        ita = json.load(f).get("iterations", {})
+    with open(os.path.join(cut, "summary.json")) as f:
+        itb = json.load(f).get("iterations", {})
+    counts = {k: v for k, v in ita.items() if not k.endswith("seconds")}  # not timings
+    if counts != {k: itb.get(k) for k in counts}:
+        fail("summary.json iterations: %r against %r" % (counts, itb))
     snaps = sorted(os.path.basename(p) for p in glob.glob(os.path.join(full, "*.h5")))
     snaps_b = sorted(os.path.basename(p) for p in glob.glob(os.path.join(cut, "*.h5")))
     if snaps != snaps_b or not snaps:

@@ -44,6 +44,12 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
                   after one digit of OUT/checkpoint/*_000001.ckpt was changed (where
                   our solvers keep it; not checked if there is none): ERROR "input:
                   ...", exit 2
+  checkpoint_iterations  only for a solid that declares caps=rollback,checkpoint: CONFIG
+                  rollback=on, step 0 (loads A), step 1 with CHECKPOINT twice (iteration 0
+                  loads B, iteration 1 loads A), step 2 (loads B, PROBES), STOP; a second
+                  process with rollback=on, restart=1: READY must be iteration 1's state bit
+                  for bit (each iteration rewrites checkpoint N) and its step 2 the first
+                  run's step 2 (section 6, "Checkpoints")
   curve           on tcp with CURVE (section 10): the key file reaches the solver
                   as the coupler passes it (MPS_COUPLING_KEY); HELLO, READY, one
                   ADVANCE, STOP/BYE, exit 0, authenticated with the issued key
@@ -513,7 +519,7 @@ class Suite:
                    f'nprobes {f["nprobes"]}, names {names}')
         return m
 
-    def advance(self, s, k, t, dt, n_sub, payload, loads=None, flags=0):
+    def advance(self, s, k, t, dt, n_sub, payload, loads=None, flags=0, iteration=0):
         """One ADVANCE; returns (frames, decoded RESULT) or raises Stop."""
         kw = {}
         if payload == mp.Payload.LOADS:
@@ -522,7 +528,7 @@ class Suite:
                       pressure=np.linalg.norm(force, axis=1) / self.dp if len(ids) else
                       np.zeros(0))
         s.send(mp.Message(mp.Type.ADVANCE, payload=payload, flags=flags, step=k, time=t, dt=dt,
-                          n_sub=n_sub, **kw))
+                          n_sub=n_sub, iteration=iteration, **kw))
         frames, el = s.recv(self.args.step_timeout)
         if frames is None:
             self.check(f'{s.name}.result.arrives', False,
@@ -1019,6 +1025,60 @@ class Suite:
             s3.close()
         self.checkpoint_damaged(s.out)
 
+    def scenario_checkpoint_iterations(self, s):
+        """Section 6, checkpoints under implicit coupling: CHECKPOINT comes on every
+        iteration of the step and each rewrites checkpoint N, so checkpoint N holds the
+        last iteration's state, the one the next step starts from (the coupler's
+        restart of an implicit run relies on it, docs/restart.md)."""
+        text = self.hello(s)
+        caps = mp.capabilities(text)
+        if 'checkpoint' not in caps or 'rollback' not in caps:
+            print(f'INFO  checkpoint_iterations: the solid lacks caps=rollback,checkpoint '
+                  f'({text!r}): not checked')
+            return
+        r = self.ready(s, 'rollback=on\n')
+        free = (r.surface == 1) & (r.fixed == 0)
+        ids = r.id[free]
+        a = (ids, np.tile([self.args.force, 0.0], (len(ids), 1)))
+        b = (ids, np.tile([-3.0 * self.args.force, 0.0], (len(ids), 1)))
+        dt, n = self.args.dt, self.n_sub(r.dt)
+        L, ck = mp.Payload.LOADS, mp.F_CHECKPOINT
+        self.advance(s, 0, 0.0, dt, n, L, a)
+        _, m0 = self.advance(s, 1, dt, dt, n, L, b, ck, iteration=0)
+        _, m1 = self.advance(s, 1, dt, dt, n, L, a, ck, iteration=1)
+        f2, m2 = self.advance(s, 2, 2 * dt, dt, n, L, b, mp.F_PROBES)
+        s.send(mp.Message(mp.Type.STOP, step=3, time=3 * dt))
+        bye, _ = s.recv(EXIT_DEADLINE)
+        rc = s.wait_exit(EXIT_DEADLINE)
+        self.check('checkpoint_iterations.run', bye is not None and rc == 0 and
+                   m0.x.tobytes() != m1.x.tobytes(),
+                   f'steps 0-2, step 1 repeated with other loads (CHECKPOINT on both '
+                   f'iterations), BYE, exit {rc}' + ('' if m0.x.tobytes() != m1.x.tobytes() else
+                                                     ': the two iterations gave one state'))
+        s2 = Session(self, 'checkpoint_iterations_restart')
+        s2.out = s.out
+        try:
+            self.hello(s2)
+            m = self.ready(s2, 'rollback=on\nrestart=1\n')
+            d = [k for k in ('x', 'v') if getattr(m, k).tobytes() != getattr(m1, k).tobytes()]
+            self.check('checkpoint_iterations.ready', not d and m.dt == m1.dt,
+                       'READY after restart=1: the state of step 1\'s last iteration bit for bit'
+                       if not d and m.dt == m1.dt else
+                       f'differs from step 1\'s last iteration in {", ".join(d) or "dt"}' +
+                       (' (it is the first iteration\'s)' if m.x.tobytes() == m0.x.tobytes()
+                        else ''))
+            g2, n2 = self.advance(s2, 2, 2 * dt, dt, n, L, b, mp.F_PROBES)
+            d = [k for k in ('x', 'v', 'probes')
+                 if np.asarray(getattr(m2, k)).tobytes() != np.asarray(getattr(n2, k)).tobytes()]
+            d += [k for k in ('time', 'dt', 'nprobes') if f2[k] != g2[k]]
+            self.check('checkpoint_iterations.continue', not d,
+                       'step 2 after the restart: the uninterrupted RESULT bit for bit'
+                       if not d else f'differs in {", ".join(d)}')
+        except Stop:
+            pass
+        finally:
+            s2.close()
+
     def checkpoint_damaged(self, out):
         """A checkpoint changed on disk (one digit) must be refused as an input
         error, not read as another state. Where a solver keeps its checkpoints
@@ -1081,7 +1141,8 @@ class Suite:
 
     SCENARIOS = ('run', 'abort', 'reject', 'bad_magic', 'truncated', 'wrong_version',
                  'unexpected', 'unknown_id', 'duplicate_id', 'unknown_key', 'case_key', 'motion',
-                 'timeout', 'iteration_unasked', 'rollback', 'checkpoint', 'curve', 'curve_no_key')
+                 'timeout', 'iteration_unasked', 'rollback', 'checkpoint', 'checkpoint_iterations',
+                 'curve', 'curve_no_key')
 
     def run(self):
         print(f'conformance: solid {" ".join(self.command)}, case {self.args.case}', flush=True)
