@@ -1013,17 +1013,22 @@ class Suite:
             pass
         finally:
             s2.close()
-        s3 = Session(self, 'checkpoint_missing')
-        s3.out = s.out
+        self.restart_refused(s.out, 9, 'checkpoint.missing')
+        self.checkpoint_damaged(s.out)
+
+    def restart_refused(self, out, number, name):
+        """A new solver process told to restart from checkpoint `number` in out
+        must answer an input error and exit 2."""
+        s = Session(self, name.replace('.', '_'))
+        s.out = out
         try:
-            self.hello(s3)
-            s3.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s3, 'restart=9\n')))
-            self.expect_error(s3, 'checkpoint.missing', 'input', 2)
+            self.hello(s)
+            s.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s, f'restart={number}\n')))
+            self.expect_error(s, name, 'input', 2)
         except Stop:
             pass
         finally:
-            s3.close()
-        self.checkpoint_damaged(s.out)
+            s.close()
 
     def scenario_checkpoint_iterations(self, s):
         """Section 6, checkpoints under implicit coupling: CHECKPOINT comes on every
@@ -1100,16 +1105,7 @@ class Suite:
         data[k] = 49 if data[k] != 49 else 50
         with open(files[0], 'wb') as f:
             f.write(data)
-        s4 = Session(self, 'checkpoint_damaged')
-        s4.out = out
-        try:
-            self.hello(s4)
-            s4.send(mp.Message(mp.Type.CONFIG, text=self.config_text(s4, 'restart=1\n')))
-            self.expect_error(s4, 'checkpoint.damaged', 'input', 2)
-        except Stop:
-            pass
-        finally:
-            s4.close()
+        self.restart_refused(out, 1, 'checkpoint.damaged')
 
     def scenario_curve(self, s):
         """Section 10: a whole short conversation over tcp with CURVE."""
