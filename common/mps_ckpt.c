@@ -74,53 +74,62 @@ enum mps_status mps_ckpt_put(struct mps_ckpt *c, const char *name, const void *d
     return MPS_OK;
 }
 
-enum mps_status mps_ckpt_get_any(struct mps_ckpt *c, const char *name, const void **data,
-                                 size_t *bytes, struct mps_err *err)
+/* The block at pos: its name (*got, *nl), where its data start (*at) and
+ * their length (*bytes). 0, or -1 where the header is cut short, -2 where the
+ * data run past the end. The one reading of the layout mps_ckpt_put writes. */
+static int block_at(const struct mps_ckpt *c, size_t pos, const char **got, size_t *nl,
+                    size_t *at, size_t *bytes)
 {
     uint16_t n16;
     uint64_t b64;
-    size_t nl = strlen(name);
-    if (c->pos + sizeof n16 > c->len)
-        return mps_err_set(err, MPS_EINPUT, "checkpoint: ends where block '%s' should be", name);
-    memcpy(&n16, c->buf + c->pos, sizeof n16);
-    const char *got = (const char *)c->buf + c->pos + sizeof n16;
+    if (pos + sizeof n16 > c->len)
+        return -1;
+    memcpy(&n16, c->buf + pos, sizeof n16);
+    *got = (const char *)c->buf + pos + sizeof n16;
+    *nl = n16;
     size_t head = pad8(sizeof n16 + n16);
-    if (c->pos + head + sizeof b64 > c->len)
+    if (pos + head + sizeof b64 > c->len)
+        return -1;
+    memcpy(&b64, c->buf + pos + head, sizeof b64);
+    *at = pos + head + sizeof b64;
+    if (b64 > c->len - *at || pad8((size_t)b64) > c->len - *at)
+        return -2;
+    *bytes = (size_t)b64;
+    return 0;
+}
+
+enum mps_status mps_ckpt_get_any(struct mps_ckpt *c, const char *name, const void **data,
+                                 size_t *bytes, struct mps_err *err)
+{
+    const char *got = "";
+    size_t gl = 0, at = 0, n = 0, nl = strlen(name);
+    if (c->pos + sizeof(uint16_t) > c->len)
+        return mps_err_set(err, MPS_EINPUT, "checkpoint: ends where block '%s' should be", name);
+    int r = block_at(c, c->pos, &got, &gl, &at, &n);
+    if (r == -1)
         return mps_err_set(err, MPS_EINPUT, "checkpoint: truncated at block '%s'", name);
-    if (n16 != nl || memcmp(got, name, nl) != 0)
+    if (gl != nl || memcmp(got, name, nl) != 0)
         return mps_err_set(err, MPS_EINPUT,
                            "checkpoint: block '%.*s' where '%s' should be (written by another "
                            "version or another case?)",
-                           (int)n16, got, name);
-    memcpy(&b64, c->buf + c->pos + head, sizeof b64);
-    size_t at = c->pos + head + sizeof b64;
-    if (b64 > c->len - at || pad8((size_t)b64) > c->len - at)
+                           (int)gl, got, name);
+    if (r == -2)
         return mps_err_set(err, MPS_EINPUT, "checkpoint: block '%s' runs past the end", name);
     *data = c->buf + at;
-    *bytes = (size_t)b64;
-    c->pos = at + pad8((size_t)b64);
+    *bytes = n;
+    c->pos = at + pad8(n);
     return MPS_OK;
 }
 
 int mps_ckpt_has(const struct mps_ckpt *c, const char *name)
 {
     const size_t nl = strlen(name);
-    size_t pos = 0;
-    /* the walk of mps_ckpt_get_any, without its checks of the name */
-    while (pos + sizeof(uint16_t) <= c->len) {
-        uint16_t n16;
-        uint64_t b64;
-        memcpy(&n16, c->buf + pos, sizeof n16);
-        size_t head = pad8(sizeof n16 + n16);
-        if (pos + head + sizeof b64 > c->len)
-            return 0; /* damaged: reading it will say so */
-        if (n16 == nl && memcmp(c->buf + pos + sizeof n16, name, nl) == 0)
+    const char *got;
+    size_t gl, at, n;
+    /* a damaged image has no such block here: reading it will say why */
+    for (size_t pos = 0; block_at(c, pos, &got, &gl, &at, &n) == 0; pos = at + pad8(n))
+        if (gl == nl && memcmp(got, name, nl) == 0)
             return 1;
-        memcpy(&b64, c->buf + pos + head, sizeof b64);
-        if (b64 > c->len - (pos + head + sizeof b64))
-            return 0;
-        pos += head + sizeof b64 + pad8((size_t)b64);
-    }
     return 0;
 }
 
