@@ -24,6 +24,7 @@ import glob
 import json
 import math
 import os
+import re
 import shlex
 import subprocess
 import sys
@@ -105,8 +106,10 @@ def command(out):
     p = os.path.join(out, 'command.txt')
     if not os.path.exists(p):
         return '(not run)'
-    c = open(p).read().strip()
-    return c.replace(ROOT + '/', '').replace(os.path.abspath(A.runs) + '/', 'RUNS/')
+    c = open(p).read().strip().replace(os.path.abspath(A.runs) + '/', 'RUNS/')
+    # the tree the run was made in, this one or another (a worktree): its
+    # paths start at build/ or cases/
+    return re.sub(r"(?<![\w./-])/[^\s']*?/(?=(build|cases)/)", '', c.replace(ROOT + '/', ''))
 
 
 # ---------------------------------------------------------------- common metrics
@@ -602,34 +605,64 @@ def gate():
 
 # ---------------------------------------------------------------- 4. plate at rest
 
-REST = dict(h1=0.072, h2=0.024, top=0.084, b=0.012, E=1.0e6)   # clamped at y = 0
+REST = dict(h1=0.072, h2=0.024, top=0.084, b=0.012, E=1.0e6, rho_s=2500.0)   # clamped at y = 0
 
 
-def rest_analytic(dp, effective=True):
+def rest_levels(dp, effective=True):
+    cut = dp / 2 if effective else 0.0
+    return REST['h1'] - cut, REST['h2'] - cut
+
+
+def rest_analytic(dp, effective=True, weight=True):
     """Tip deflection (m) at the probe (the top row's centre) of the plate as
     an Euler-Bernoulli cantilever under the net still-water load, with the
     free surfaces at the top particles' centres (h - dp/2: where the fluid
     puts P = 0) or at the nominal levels. Clamped at the floor (y = 0, the
-    top of the clamped rows). Continuum E I = E b^3 / 12."""
+    top of the clamped rows). Continuum E I = E b^3 / 12.
+    weight: the plate's own weight as well (a beam-column): the part above a
+    section, rho_s g b per metre of height, hangs over it at its deflected
+    position and adds its moment, rho_s g b int_s^L (w(t) - w(s)) dt. The
+    plate is clamped into the floor with no water under it, so no buoyancy
+    lifts it: the side faces' pressure is horizontal. Solved by fixed-point
+    iteration (the axial load is 15% of the self-weight buckling load
+    7.84 E I / L^3, so it converges). At 3 mm it bends the plate 18.7% more."""
     r = REST
-    cut = dp / 2 if effective else 0.0
-    h1, h2 = r['h1'] - cut, r['h2'] - cut
-    yc = 0.0
-    L = r['top'] - yc
-    s = np.linspace(0, L, 4001)
-    y = yc + s
-    q = RHO_W * G * (np.clip(h1 - y, 0, None) - np.clip(h2 - y, 0, None))
-    M = np.array([np.trapz(q[i:] * (s[i:] - s[i]), s[i:]) for i in range(len(s))])
+    h1, h2 = rest_levels(dp, effective)
+    L = r['top']
+    s = np.linspace(0, L, 2001)
+    q = RHO_W * G * (np.clip(h1 - s, 0, None) - np.clip(h2 - s, 0, None))
+    mu = r['rho_s'] * G * r['b'] if weight else 0.0
     EI = r['E'] * r['b'] ** 3 / 12
-    kap = M / EI
-    slope = np.concatenate([[0], np.cumsum(0.5 * (kap[1:] + kap[:-1]) * np.diff(s))])
-    w = np.concatenate([[0], np.cumsum(0.5 * (slope[1:] + slope[:-1]) * np.diff(s))])
-    return float(np.interp(L - dp / 2, s, w))
+
+    def tail(f):  # int_s^L f(t) dt, for every s
+        c = np.concatenate([[0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(s))])
+        return c[-1] - c
+
+    def twice(k):  # w from w'' = k, w(0) = w'(0) = 0
+        slope = np.concatenate([[0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
+        return np.concatenate([[0], np.cumsum(0.5 * (slope[1:] + slope[:-1]) * np.diff(s))])
+    # M(s) = int_s^L q(t) (t - s) dt
+    Mq = tail(q * s) - s * tail(q)
+    w = np.zeros_like(s)
+    for _ in range(200):
+        wn = twice((Mq + mu * (tail(w) - (L - s) * w)) / EI)
+        if np.max(np.abs(wn - w)) < 1e-13:
+            break
+        w = wn
+    return float(np.interp(L - dp / 2, s, wn))
 
 
-def rest_solid_alone(dp):
-    """The MPS plate alone under the same net load (effective levels)."""
-    name = f'rest_solid_alone_{int(dp * 1e4)}'
+def rest_loads(dp):
+    """The hydrostatic force (N/m, +x) and moment about the plate's foot
+    (0.3, 0) (N m/m, counterclockwise positive) with the effective levels."""
+    h1, h2 = rest_levels(dp)
+    return RHO_W * G * (h1 ** 2 - h2 ** 2) / 2, -RHO_W * G * (h1 ** 3 - h2 ** 3) / 6
+
+
+def rest_solid_alone(dp, gravity=True):
+    """The MPS plate alone under the same net load (effective levels), with
+    its own weight (gravity) or without."""
+    name = f'rest_solid_alone_{"g_" if gravity else ""}{int(dp * 1e4)}'
     out = run_dir(name)
     res = os.path.join(out, 'result.json')
     if os.path.exists(res) and not A.force:
@@ -637,10 +670,11 @@ def rest_solid_alone(dp):
     if A.report_only:
         return None
     os.makedirs(out, exist_ok=True)
+    h1, h2 = rest_levels(dp)
     cmd = [os.path.join(A.build, 'bench', 'solid_static_load'),
            os.path.join(ROOT, 'cases/hard_plate_at_rest/case.yml'), '--body', 'plate',
-           '--water-level', str(REST['h1'] - dp / 2), '--water-right', str(REST['h2'] - dp / 2),
-           '--set', f'dp={dp}', '--damping', '60', '--max-time', '5']
+           '--water-level', str(h1), '--water-right', str(h2),
+           '--set', f'dp={dp}', '--damping', '60', '--max-time', '5'] + (['--gravity'] if gravity else [])
     with open(os.path.join(out, 'command.txt'), 'w') as f:
         f.write(' '.join(shlex.quote(c) for c in cmd) + '\n')
     p = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
@@ -654,19 +688,30 @@ def rest_solid_alone(dp):
 
 def rest():
     case = 'cases/hard_plate_at_rest/case.yml'
-    outs = {}
+    outs, rigid = {}, {}
     for dp in dps():
         for sch, acc in SCHEMES[:2]:
             outs[(dp, sch)] = coupler(f'rest_{sch}_{int(dp * 1e4)}', case,
                                       [f'dp={dp}', 'output.interval=0.5'] + scheme_sets(sch, acc))
+        rigid[dp] = coupler(f'rest_rigid_{int(dp * 1e4)}', case,
+                            [f'dp={dp}', 'output.interval=0', 'end_time=1'], solid='fake_solid')
     rows, curves = [], []
+
+    def load_vs(d, tt, a, b, dp):
+        """The mean force and moment over [a, b] against hydrostatic."""
+        if d is None or 'load_fx' not in d.dtype.names:
+            return '-'
+        m = (tt >= a) & (tt <= b)
+        F, M = rest_loads(dp)
+        return '%+.1f%% / %+.1f%%' % (100 * (np.mean(d['load_fx'][m]) / F - 1),
+                                      100 * (np.mean(d['load_moment'][m]) / M - 1))
     for (dp, sch), out in outs.items():
         s, d = summary(out), probes(out)
         t, ok, what = outcome(out, 5.0)
-        an, an_nom = rest_analytic(dp), rest_analytic(dp, effective=False)
+        an, an_ew = rest_analytic(dp), rest_analytic(dp, weight=False)
         alone = rest_solid_alone(dp)
         if s is None or d is None:
-            rows.append([sch, mm(dp), 'not run'] + [''] * 9)
+            rows.append([sch, mm(dp), 'not run'] + [''] * 11)
             continue
         tt, x = d['time'], d['tip_dx']
 
@@ -677,37 +722,74 @@ def rest():
         osc = float(np.std(x[tt >= 4])) if (tt >= 4).any() else float('nan')
         al = alone['probes']['tip_dx'] if alone else float('nan')
         rows.append([sch, mm(dp), 'yes' if ok else '**no** ' + what,
-                     '%.3f' % (1e3 * m45), '%.3f / %.3f' % (1e3 * an, 1e3 * an_nom),
+                     '%.3f' % (1e3 * m45), '%.3f / %.3f' % (1e3 * an, 1e3 * an_ew),
                      '%+.1f%%' % (100 * (m45 / an - 1)), '%.3f (%+.1f%%)' % (1e3 * al, 100 * (m45 / al - 1)),
+                     load_vs(d, tt, 4, 5, dp),
                      '%+.2f%%' % (100 * (m45 - m12) / an), '%.3f' % (1e3 * osc),
                      '%.3f' % float(np.max(d['max_speed'][tt >= 1])) if 'max_speed' in d.dtype.names else '-',
                      iters(s), wall(s), load_avg(out)])
         curves.append((f'{sch}, {mm(dp)}', d))
     for dp in dps():
-        curves.append((f'analytic, {mm(dp)}', {'time': np.array([0, 5]),
-                                               'tip_dx': np.array([1, 1]) * rest_analytic(dp)}))
+        curves.append((f'analytic with its weight, {mm(dp)}', {'time': np.array([0, 5]),
+                                                              'tip_dx': np.array([1, 1]) * rest_analytic(dp)}))
         alone = rest_solid_alone(dp)
         if alone:
             curves.append((f'solid alone, {mm(dp)}', {'time': np.array([0, 5]), 'tip_dx':
                                                       np.array([1, 1]) * alone['probes']['tip_dx']}))
     plot('hard_plate_at_rest.png', curves, 'plate at rest: tip_dx', scale=1e3, unit='mm')
+    # the solid's own error, without gravity (against Euler-Bernoulli) and with it
+    srows = []
+    for dp in list(dps()) + [0.0015, 0.001]:
+        ng, g = rest_solid_alone(dp, gravity=False), rest_solid_alone(dp)
+        if not ng or not g:
+            continue
+        e0, e1 = rest_analytic(dp, weight=False), rest_analytic(dp)
+        srows.append([mm(dp), '%d' % round(REST['b'] / dp), '%.3f / %.3f (%+.1f%%)' % (
+            1e3 * ng['probes']['tip_dx'], 1e3 * e0, 100 * (ng['probes']['tip_dx'] / e0 - 1)),
+            '%.3f / %.3f (%+.1f%%)' % (1e3 * g['probes']['tip_dx'], 1e3 * e1,
+                                       100 * (g['probes']['tip_dx'] / e1 - 1))])
+    # the water's load on a rigid plate (the fake solid): the fluid's part
+    lrows = []
+    for dp, out in rigid.items():
+        d = probes(out)
+        if d is not None:
+            lrows.append([mm(dp), load_vs(d, d['time'], 0.5, 1.0, dp)])
     lines = ['## 4. The plate at rest (`cases/hard_plate_at_rest`)', '',
              'Water 72 mm deep left of the plate and 24 mm right of it (both below its top, '
              '84 mm), at rest; the plate starts straight. Static deflection: the mean tip_dx over '
-             '4-5 s. Analytic: Euler-Bernoulli cantilever under the net hydrostatic load, with '
-             'the free surfaces at the top particles\' centres (h - dp/2, where the fluid puts '
-             'P = 0) / at the nominal levels; clamped at the floor; continuum E I. Solid alone: the MPS plate under that same net load without fluid '
-             '(bench/solid_static_load.c), which carries the solid\'s own discretisation error '
-             '(a plate 2 or 4 particles thick). Drift: mean over 4-5 s minus mean over 1-2 s, '
-             'relative to the analytic value. Oscillation: standard deviation of tip_dx over '
-             '4-5 s. Max speed: the fastest fluid particle after 1 s.', '']
-    lines += table(['scheme', 'dp', 'stable', 'static tip (mm)', 'analytic: effective / '
-                    'nominal levels (mm)', 'vs analytic', 'solid alone (mm), vs it', 'drift 1-2 '
-                    '-> 4-5 s', 'oscillation (mm)', 'max speed (m/s)', 'iterations', 'wall (s)',
-                    'load'], rows)
-    lines += ['', '![plate at rest](img/hard_plate_at_rest.png)', '', 'Commands:', '']
-    lines += ['    ' + command(o) for o in outs.values()]
-    lines += ['    ' + command(run_dir(f'rest_solid_alone_{int(dp * 1e4)}')) for dp in dps()]
+             '4-5 s. Analytic: the plate as a cantilever (continuum E I, clamped at the floor) '
+             'under the net hydrostatic load, with the free surfaces at the top particles\' '
+             'centres (h - dp/2, where the fluid puts P = 0), and under its own weight: a '
+             'beam-column, the plate above a section hanging over it at its deflected position '
+             '(bench/hard_cases.py, `rest_analytic`); the second number leaves the weight out '
+             '(Euler-Bernoulli alone). The case has gravity and the plate is soft (E = 1 MPa, '
+             'rho_s = 2500): its weight is 15% of its self-weight buckling load and bends it '
+             '18.7% further, and no buoyancy relieves it (it is clamped into the floor, no '
+             'water under it). Solid alone: the MPS plate under the same net load and its own '
+             'weight without fluid (bench/solid_static_load.c `--gravity`), which carries the '
+             'solid\'s own discretisation error (a plate 2 or 4 particles thick). Load: the mean '
+             'force and moment (about the plate\'s foot) the water puts on the plate over '
+             '4-5 s (probes `load_fx`, `load_moment`), against the hydrostatic rho g (h1\'^2 - '
+             'h2\'^2) / 2 and rho g (h1\'^3 - h2\'^3) / 6. Drift: mean over 4-5 s minus mean '
+             'over 1-2 s, relative to the analytic value. Oscillation: standard deviation of '
+             'tip_dx over 4-5 s. Max speed: the fastest fluid particle after 1 s.', '']
+    lines += table(['scheme', 'dp', 'stable', 'static tip (mm)', 'analytic: with the plate\'s '
+                    'weight / without (mm)', 'vs analytic', 'solid alone (mm), vs it',
+                    'load: force / moment vs hydrostatic', 'drift 1-2 -> 4-5 s',
+                    'oscillation (mm)', 'max speed (m/s)', 'iterations', 'wall (s)', 'load'], rows)
+    lines += ['', '![plate at rest](img/hard_plate_at_rest.png)', '',
+              'The solid alone (MPS) under the exact load: tip against the analytic value '
+              'without its weight (Euler-Bernoulli) and with it (the beam-column above):', '']
+    lines += table(['dp', 'particles across', 'no gravity: MPS / analytic (mm)',
+                    'with its weight: MPS / analytic (mm)'], srows)
+    lines += ['', 'The water\'s load on the plate held rigid (the fake solid, `--solid fake_solid`), '
+              'mean over 0.5-1 s against hydrostatic:', '']
+    lines += table(['dp', 'force / moment vs hydrostatic'], lrows)
+    lines += ['', 'Commands:', '']
+    lines += ['    ' + command(o) for o in list(outs.values()) + list(rigid.values())]
+    lines += ['    ' + command(run_dir(f'rest_solid_alone_{g}{int(dp * 1e4)}'))
+              for dp in list(dps()) + [0.0015, 0.001] for g in ('', 'g_')
+              if os.path.exists(os.path.join(run_dir(f'rest_solid_alone_{g}{int(dp * 1e4)}'), 'command.txt'))]
     lines += ['', host(outs.values()), '']
     return lines
 

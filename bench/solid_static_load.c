@@ -12,7 +12,8 @@
  * height), the pressure of still water of level H times the face it stands
  * for; with --water-right, the rightmost column below H2 gets
  * -S rho_w g (H2 - y) dp (water on both sides). Gravity on the solid is switched off (beam theory leaves out the
- * body's weight). The body is brought to rest by a damping force -C m v on
+ * body's weight) unless --gravity keeps the case's: a soft upright plate's own
+ * weight bends it further (beam-column, docs/hard_cases.md, the plate at rest). The body is brought to rest by a damping force -C m v on
  * every particle (C in 1/s; near twice the first bending frequency settles it
  * fastest), added to the loads each step, and stepped at the model's stable
  * step until the first probe moves less than 1e-7 of its value over 0.01 s
@@ -44,7 +45,7 @@ int main(int argc, char **argv)
     const char *case_path = NULL, *body_name = NULL, *model = NULL;
     double level = NAN, right = -INFINITY, scale = 1.0, damping = 150.0, tmax = 2.0;
     const char *sets[MAX_SETS + 1];
-    int nsets = 0;
+    int nsets = 0, keep_gravity = 0;
     sets[nsets++] = "gravity.y=0";
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -62,6 +63,8 @@ int main(int argc, char **argv)
             damping = atof(argv[++i]);
         else if (!strcmp(a, "--max-time") && v)
             tmax = atof(argv[++i]);
+        else if (!strcmp(a, "--gravity"))
+            keep_gravity = 1;
         else if (!strcmp(a, "--set") && v && nsets < MAX_SETS)
             sets[nsets++] = argv[++i];
         else if (a[0] != '-' && !case_path)
@@ -69,7 +72,7 @@ int main(int argc, char **argv)
         else
             return fail("usage: solid_static_load CASE.yml --body NAME --water-level H "
                         "[--water-right H2] [--model mps|tlsph] [--load-scale S] [--damping C] "
-                        "[--max-time T] [--set key=value]...");
+                        "[--max-time T] [--gravity] [--set key=value]...");
     }
     if (!case_path || !body_name || !isfinite(level) || !(damping >= 0.0) || !(tmax > 0.0))
         return fail("needs CASE.yml, --body NAME and --water-level H (m); --damping >= 0, "
@@ -80,7 +83,9 @@ int main(int argc, char **argv)
     const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
                                                  mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
-    if (mps_case_load(&cs, case_path, sets, nsets, tables, 3, ignore, &err))
+    /* sets[0] is the switch-off of gravity */
+    if (mps_case_load(&cs, case_path, sets + keep_gravity, nsets - keep_gravity, tables, 3, ignore,
+                      &err))
         return fprintf(stderr, "solid_static_load: %s\n", err.msg), 2;
     struct solid_scene *sc = malloc(sizeof *sc);
     const struct solid_model_ops *ops =
