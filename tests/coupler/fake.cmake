@@ -6,7 +6,7 @@ set_target_properties(fake_solid PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BIN
 
 # Integration tests of the coupler (three processes) and its failure handling.
 foreach(t plate_force body_loads moving_plate solid_crash solid_hang hello_deadline ready_deadline fluid_killed solid_killed
-          interrupt fluid_fails wrong_version wrong_role result_echo solver_input_error fake_case_error summary_unwritable cpu_placement
+          interrupt fluid_fails wrong_version wrong_role result_echo solver_input_error fake_case_error probe_name_clash summary_unwritable cpu_placement
           stranger run_dir_private external_key no_rollback implicit_fake)
   add_test(NAME coupler_${t}
            COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/test_coupler.py

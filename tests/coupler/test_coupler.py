@@ -351,6 +351,22 @@ def t_fake_case_error():
           f'one line, the coupler\'s, naming the key: {err.strip()[:300]!r}')
 
 
+def t_probe_name_clash():
+    """Two probes of one name would be two columns probes.csv cannot tell
+    apart: a case probe named like the coupler's solid_fx, and one named like
+    the fake solid's own plate_fx. The coupler refuses before the run, names
+    the case file and the name, exit 2. (It used to write both columns.)"""
+    for key, name in (('fluid.probes.1.name', 'solid_fx'), ('solid.probes.0.name', 'plate_fx')):
+        out = tempfile.mkdtemp(prefix='cpl_clash_')
+        rc, err = run([SCENE, '--out', out, '--quiet', '--solid', 'fake_solid',
+                       '--set', 'end_time=0.02', '--set', f'{key}={name}'])
+        check(rc == 2, f'{key}={name}: exit status {rc} (expected 2: an input error)')
+        check(f"{SCENE}: two probes named '{name}'" in err,
+              f'{key}={name}: the coupler names the case and the probe: {err.strip()[:300]!r}')
+        check(not os.path.exists(os.path.join(out, 'probes.csv')),
+              f'{key}={name}: no probes.csv written')
+
+
 def t_summary_unwritable():
     """A run whose record cannot be written does not end as a success: with
     OUT/solid_summary.json taken by a directory, the coupler names the file
