@@ -57,6 +57,20 @@ static enum mps_status alloc_probes(struct mps_probes **out, const char *path, i
     return MPS_OK;
 }
 
+enum mps_status mps_probes_check_names(const char *const *names, int n, const char *case_path,
+                                       struct mps_err *err)
+{
+    for (int a = 0; a < n; a++)
+        for (int b = a + 1; b < n; b++)
+            if (names[a] && names[b] && !strcmp(names[a], names[b]))
+                return mps_err_set(err, MPS_EINPUT,
+                                   "%s: two probes named '%s' share probes.csv (fluid.probes, "
+                                   "solid.probes, a solver's own probes and the coupler's "
+                                   "solid_fx, solid_fy, coupling_iterations): rename one",
+                                   case_path ? case_path : "case", names[a]);
+    return MPS_OK;
+}
+
 enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const char *comment,
                                 const char *const *names, int n, struct mps_err *err)
 {

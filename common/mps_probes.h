@@ -13,6 +13,11 @@
 struct mps_probes;
 
 /* comment: "# ..." lines written first, verbatim (NULL: none). */
+/* MPS_EINPUT naming the case file and the name when two of the n names are
+ * equal: probes.csv could not tell their columns apart. Every writer of a
+ * probes.csv (fluid and solid alone, the coupler's merged table) asks it. */
+enum mps_status mps_probes_check_names(const char *const *names, int n, const char *case_path,
+                                       struct mps_err *err);
 enum mps_status mps_probes_open(struct mps_probes **out, const char *path, const char *comment,
                                 const char *const *names, int n, struct mps_err *err);
 /* One row: time then n values (%.9g). */

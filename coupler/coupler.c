@@ -557,22 +557,15 @@ static enum mps_status open_probes(struct coupler *c, struct mps_err *err)
     }
     if (c->implicit)
         names[n++] = "coupling_iterations";
-    /* Two columns of one name cannot be told apart in probes.csv: a case
-     * probe named like a solver's own probe, or like the coupler's. */
-    for (int a = 0; a < n; a++)
-        for (int b = a + 1; b < n; b++)
-            if (!strcmp(names[a], names[b]))
-                return mps_err_set(err, MPS_EINPUT,
-                                   "%s: two probes named '%s' (fluid.probes, solid.probes, a "
-                                   "solver's own probes and the coupler's solid_fx, solid_fy, "
-                                   "coupling_iterations share probes.csv): rename one",
-                                   c->cs ? mps_case_path(c->cs) : "case", names[a]);
+    enum mps_status st = mps_probes_check_names(names, n, c->cs ? mps_case_path(c->cs) : NULL, err);
+    if (st)
+        return st;
     char path[4200];
     snprintf(path, sizeof path, "%s/probes.csv", c->out);
     if (c->restart)
         return mps_probes_resume(&c->probes, path, c->mark.table_bytes[0], n, err);
     char *comment = mps_prov_comment(c->cs, "coupler");
-    enum mps_status st = mps_probes_open(&c->probes, path, comment, names, n, err);
+    st = mps_probes_open(&c->probes, path, comment, names, n, err);
     free(comment);
     return st;
 }

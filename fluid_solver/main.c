@@ -305,6 +305,8 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
     for (int k = 0; k < prm.nprobes; k++)
         names[k] = prm.probes[k].name;
     proto_join_names(names, prm.nprobes, r->probe_names, sizeof r->probe_names);
+    if ((st = mps_probes_check_names(names, prm.nprobes, mps_case_path(r->cs), err)))
+        return st;
     st = mps_h5_open(&r->h5, r->out, prefix, "fluid_solver", r->case_yaml, err);
     /* under the coupler, probes travel in RESULT and the coupler writes them */
     if (!st && !r->coupled && r->resumed) {

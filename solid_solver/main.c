@@ -220,6 +220,8 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     }
     for (int k = 0; k < r.nprobes; k++)
         names[k] = r.ops->probe_name(r.model, k);
+    if ((st = mps_probes_check_names(names, r.nprobes, mps_case_path(c), err)))
+        goto done;
     char path[4096];
     snprintf(path, sizeof path, "%s/probes.csv", cli->out_dir);
     if (cli->restart_dir) {
