@@ -82,8 +82,9 @@ def run_list():
     # The implicit coupling lifts the explicit one's added-mass limit on the
     # step (docs/sloshing.md, "The implicit coupling lifts the limit"): the
     # fluid's CFL step, capped at 5e-4 s, instead of the cases' 5e-5 s
-    r['high_1_mps_implicit'] = ('high', ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
-                                         'output.interval=0.1'], None)
+    for case in ('low', 'high'):
+        r[f'{case}_1_mps_implicit'] = (case, ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
+                                              'output.interval=0.1'], None)
     return r
 
 

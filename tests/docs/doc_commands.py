@@ -283,18 +283,23 @@ def main():
             took = time.time() - t0
             shown = script.strip().replace('\n', '\n     ')
             if r.returncode != 0:
-                failed.append(where)
-                print(f'FAIL {where} ({took:.1f} s, exit {r.returncode}): {shown}\n'
-                      + r.stdout.decode(errors='replace')[-3000:], flush=True)
+                msg = (f'FAIL {where} ({took:.1f} s, exit {r.returncode}): {shown}\n'
+                       + r.stdout.decode(errors='replace')[-3000:])
+                failed.append((where, msg))
+                print(msg, flush=True)
             else:
                 print(f'ok   {where} ({took:.1f} s): {shown}'
                       + (f'  [{"; ".join(notes)}]' if notes else ''), flush=True)
     finally:
         shutil.rmtree(root, ignore_errors=True)
+    # the failures again at the end: a log cut to its head and tail (CI's
+    # excerpt) loses the middle, where they were printed
+    for where, msg in failed:
+        print(f'\n(again) {msg}')
     for e in stale:
         print(f'FAIL stale SHORT entry (matches no command of {e[0]}): {e[1]}')
     print(f'doc_commands: {len(plan)} commands, {len(failed)} failed'
-          + (f': {", ".join(failed)}' if failed else ''))
+          + (f': {", ".join(w for w, _ in failed)}' if failed else ''))
     return 1 if failed or stale else 0
 
 
