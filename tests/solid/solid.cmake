@@ -60,3 +60,11 @@ add_test(NAME solid_cantilever_b5
     ${SOLID_OUT}/cantilever_b5 ${SOLID_BIN}
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(solid_cantilever_b5 PROPERTIES TIMEOUT 60 LABELS validation)
+
+# The 2-D finite-element reference of the plate at rest (bench/plate_fe.py,
+# Q9 elements, numpy alone as on CI): a slender cantilever against
+# Euler-Bernoulli + shear, the self-weight buckling load against Greenhill's
+# 7.837 E I / L^3, and the thick plate's mesh convergence (nx = 4 vs 8).
+add_test(NAME plate_fe_reference COMMAND /usr/bin/python3 tests/solid/plate_fe_check.py
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(plate_fe_reference PROPERTIES TIMEOUT 60 LABELS unit)
