@@ -36,6 +36,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 from bench_doc import host_line, write_keeping_notes  # noqa: E402
+import plate_fe  # noqa: E402
 
 DOC = os.path.join(ROOT, 'docs', 'hard_cases.md')
 IMG = os.path.join(ROOT, 'docs', 'img')
@@ -106,7 +107,10 @@ def command(out):
     p = os.path.join(out, 'command.txt')
     if not os.path.exists(p):
         return '(not run)'
+    # the runs directory the run was made in (this one, or one whose runs
+    # this one links to): its --out names the run's own directory
     c = open(p).read().strip().replace(os.path.abspath(A.runs) + '/', 'RUNS/')
+    c = re.sub(r"--out /[^\s']*/(?=[^/\s']+(\s|$))", '--out RUNS/', c)
     # the tree the run was made in, this one or another (a worktree): its
     # paths start at build/ or cases/
     return re.sub(r"(?<![\w./-])/[^\s']*?/(?=(build|cases)/)", '', c.replace(ROOT + '/', ''))
@@ -605,6 +609,7 @@ def gate():
 
 # ---------------------------------------------------------------- 4. plate at rest
 
+SOLID_ALONE_DPS = [0.0015, 0.00075]   # finer plates alone: the solid's convergence
 REST = dict(h1=0.072, h2=0.024, top=0.084, b=0.012, E=1.0e6, rho_s=2500.0)   # clamped at y = 0
 
 
@@ -621,35 +626,30 @@ def rest_analytic(dp, effective=True, weight=True):
     top of the clamped rows). Continuum E I = E b^3 / 12.
     weight: the plate's own weight as well (a beam-column): the part above a
     section, rho_s g b per metre of height, hangs over it at its deflected
-    position and adds its moment, rho_s g b int_s^L (w(t) - w(s)) dt. The
-    plate is clamped into the floor with no water under it, so no buoyancy
-    lifts it: the side faces' pressure is horizontal. Solved by fixed-point
-    iteration (the axial load is 15% of the self-weight buckling load
-    7.84 E I / L^3, so it converges). At 3 mm it bends the plate 18.7% more."""
+    position and adds its moment. The plate is clamped into the floor with
+    no water under it, so no buoyancy lifts it: the side faces' pressure is
+    horizontal. The axial load is 15% of the self-weight buckling load
+    7.84 E I / L^3; at 3 mm it bends the plate 18.7% more. The formula is
+    plate_fe.euler_bernoulli_tip, beside the 2-D FE it is compared with."""
     r = REST
     h1, h2 = rest_levels(dp, effective)
-    L = r['top']
-    s = np.linspace(0, L, 2001)
-    q = RHO_W * G * (np.clip(h1 - s, 0, None) - np.clip(h2 - s, 0, None))
-    mu = r['rho_s'] * G * r['b'] if weight else 0.0
-    EI = r['E'] * r['b'] ** 3 / 12
+    return plate_fe.euler_bernoulli_tip(dp, weight, b=r['b'], L=r['top'], E=r['E'],
+                                        rho_s=r['rho_s'], h1=h1, h2=h2)
 
-    def tail(f):  # int_s^L f(t) dt, for every s
-        c = np.concatenate([[0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(s))])
-        return c[-1] - c
 
-    def twice(k):  # w from w'' = k, w(0) = w'(0) = 0
-        slope = np.concatenate([[0], np.cumsum(0.5 * (k[1:] + k[:-1]) * np.diff(s))])
-        return np.concatenate([[0], np.cumsum(0.5 * (slope[1:] + slope[:-1]) * np.diff(s))])
-    # M(s) = int_s^L q(t) (t - s) dt
-    Mq = tail(q * s) - s * tail(q)
-    w = np.zeros_like(s)
-    for _ in range(200):
-        wn = twice((Mq + mu * (tail(w) - (L - s) * w)) / EI)
-        if np.max(np.abs(wn - w)) < 1e-13:
-            break
-        w = wn
-    return float(np.interp(L - dp / 2, s, wn))
+def fe_reference(dp, mode='follower', weight=True):
+    """The converged 2-D finite-element tip (m) of the plate at rest, from
+    bench/plate_fe_reference.json (`bench/plate_fe.py --json`): 'follower' the
+    water pressure normal to the deformed faces (the coupled runs' load),
+    'nonlinear' fixed horizontal forces at the material points (what
+    bench/solid_static_load.c applies), 'linear' the consistent linearisation
+    (the beam-column's). None where the file has no such dp."""
+    path = os.path.join(ROOT, 'bench', 'plate_fe_reference.json')
+    if not os.path.exists(path):
+        return None
+    row = json.load(open(path))['dp'].get(repr(dp))
+    key = mode + ('' if weight else '_no_weight')
+    return row[key][0] if row and key in row else None
 
 
 def rest_loads(dp):
@@ -708,10 +708,12 @@ def rest():
     for (dp, sch), out in outs.items():
         s, d = summary(out), probes(out)
         t, ok, what = outcome(out, 5.0)
-        an, an_ew = rest_analytic(dp), rest_analytic(dp, weight=False)
+        an = rest_analytic(dp)
+        fe = fe_reference(dp) or float('nan')
         alone = rest_solid_alone(dp)
+        fe_dead = fe_reference(dp, 'nonlinear') or float('nan')
         if s is None or d is None:
-            rows.append([sch, mm(dp), 'not run'] + [''] * 11)
+            rows.append([sch, mm(dp), 'not run'] + [''] * 12)
             continue
         tt, x = d['time'], d['tip_dx']
 
@@ -722,16 +724,20 @@ def rest():
         osc = float(np.std(x[tt >= 4])) if (tt >= 4).any() else float('nan')
         al = alone['probes']['tip_dx'] if alone else float('nan')
         rows.append([sch, mm(dp), 'yes' if ok else '**no** ' + what,
-                     '%.3f' % (1e3 * m45), '%.3f / %.3f' % (1e3 * an, 1e3 * an_ew),
-                     '%+.1f%%' % (100 * (m45 / an - 1)), '%.3f (%+.1f%%)' % (1e3 * al, 100 * (m45 / al - 1)),
+                     '%.3f' % (1e3 * m45), '%.3f / %.3f' % (1e3 * fe, 1e3 * an),
+                     '%+.1f%% / %+.1f%%' % (100 * (m45 / fe - 1), 100 * (m45 / an - 1)),
+                     '%.3f (%+.1f%% from the FE\'s %.3f)' % (1e3 * al, 100 * (al / fe_dead - 1),
+                                                              1e3 * fe_dead),
+                     '%+.1f%%' % (100 * (m45 / al - 1)),
                      load_vs(d, tt, 4, 5, dp),
                      '%+.2f%%' % (100 * (m45 - m12) / an), '%.3f' % (1e3 * osc),
                      '%.3f' % float(np.max(d['max_speed'][tt >= 1])) if 'max_speed' in d.dtype.names else '-',
                      iters(s), wall(s), load_avg(out)])
         curves.append((f'{sch}, {mm(dp)}', d))
     for dp in dps():
-        curves.append((f'analytic with its weight, {mm(dp)}', {'time': np.array([0, 5]),
-                                                              'tip_dx': np.array([1, 1]) * rest_analytic(dp)}))
+        if fe_reference(dp):
+            curves.append((f'2-D FE reference, {mm(dp)}', {'time': np.array([0, 5]),
+                                                          'tip_dx': np.array([1, 1]) * fe_reference(dp)}))
         alone = rest_solid_alone(dp)
         if alone:
             curves.append((f'solid alone, {mm(dp)}', {'time': np.array([0, 5]), 'tip_dx':
@@ -739,15 +745,18 @@ def rest():
     plot('hard_plate_at_rest.png', curves, 'plate at rest: tip_dx', scale=1e3, unit='mm')
     # the solid's own error, without gravity (against Euler-Bernoulli) and with it
     srows = []
-    for dp in list(dps()) + [0.0015, 0.001]:
+    for dp in list(dps()) + SOLID_ALONE_DPS:
         ng, g = rest_solid_alone(dp, gravity=False), rest_solid_alone(dp)
         if not ng or not g:
             continue
-        e0, e1 = rest_analytic(dp, weight=False), rest_analytic(dp)
-        srows.append([mm(dp), '%d' % round(REST['b'] / dp), '%.3f / %.3f (%+.1f%%)' % (
-            1e3 * ng['probes']['tip_dx'], 1e3 * e0, 100 * (ng['probes']['tip_dx'] / e0 - 1)),
-            '%.3f / %.3f (%+.1f%%)' % (1e3 * g['probes']['tip_dx'], 1e3 * e1,
-                                       100 * (g['probes']['tip_dx'] / e1 - 1))])
+        row = [mm(dp), '%d' % round(REST['b'] / dp)]
+        for r, weight in ((ng, False), (g, True)):
+            v, e, fe = r['probes']['tip_dx'], rest_analytic(dp, weight=weight), \
+                fe_reference(dp, 'nonlinear', weight)
+            row.append('%.3f / %.3f (%+.1f%%) / %.3f (%+.1f%%)' % (
+                1e3 * v, 1e3 * fe, 100 * (v / fe - 1), 1e3 * e, 100 * (v / e - 1))
+                if fe else '%.3f / - / %.3f (%+.1f%%)' % (1e3 * v, 1e3 * e, 100 * (v / e - 1)))
+        srows.append(row)
     # the water's load on a rigid plate (the fake solid): the fluid's part
     lrows = []
     for dp, out in rigid.items():
@@ -757,38 +766,45 @@ def rest():
     lines = ['## 4. The plate at rest (`cases/hard_plate_at_rest`)', '',
              'Water 72 mm deep left of the plate and 24 mm right of it (both below its top, '
              '84 mm), at rest; the plate starts straight. Static deflection: the mean tip_dx over '
-             '4-5 s. Analytic: the plate as a cantilever (continuum E I, clamped at the floor) '
-             'under the net hydrostatic load, with the free surfaces at the top particles\' '
-             'centres (h - dp/2, where the fluid puts P = 0), and under its own weight: a '
-             'beam-column, the plate above a section hanging over it at its deflected position '
-             '(bench/hard_cases.py, `rest_analytic`); the second number leaves the weight out '
-             '(Euler-Bernoulli alone). The case has gravity and the plate is soft (E = 1 MPa, '
-             'rho_s = 2500): its weight is 15% of its self-weight buckling load and bends it '
-             '18.7% further, and no buoyancy relieves it (it is clamped into the floor, no '
-             'water under it). Solid alone: the MPS plate under the same net load and its own '
-             'weight without fluid (bench/solid_static_load.c `--gravity`), which carries the '
-             'solid\'s own discretisation error (a plate 2 or 4 particles thick). Load: the mean '
+             '4-5 s. Reference: the converged 2-D finite-element solution of the same '
+             'continuum (bench/plate_fe.py: plane strain, nu = 0, clamped at the floor, '
+             'geometrically nonlinear, the still water\'s pressure normal to the deformed faces '
+             'with the free surfaces at the top particles\' centres, h - dp/2, where the fluid '
+             'puts P = 0, and the plate\'s own weight; its values in '
+             'bench/plate_fe_reference.json, converged to 1e-6). Beside it the beam theory '
+             '(`rest_analytic`: Euler-Bernoulli as a beam-column under its weight), which '
+             'the plate, 7 times as tall as thick, exceeds by 1.8% (shear, the 2-D root); the '
+             'earlier versions of this table compared with it. The case has gravity and the '
+             'plate is soft (E = 1 MPa, rho_s = 2500): its weight is 15% of its self-weight '
+             'buckling load and bends it 19% further, and no buoyancy relieves it (it is '
+             'clamped into the floor, no water under it). Solid alone: the MPS plate under the '
+             'same net load and its own weight without fluid (bench/solid_static_load.c '
+             '`--gravity`: fixed horizontal forces at the particles, against the FE with such '
+             'dead loads, 3% above the follower value), which carries the solid\'s own '
+             'discretisation error (a plate 2 or 4 particles thick); the next column is the '
+             'coupled tip against it. Load: the mean '
              'force and moment (about the plate\'s foot) the water puts on the plate over '
              '4-5 s (probes `load_fx`, `load_moment`), against the hydrostatic rho g (h1\'^2 - '
              'h2\'^2) / 2 and rho g (h1\'^3 - h2\'^3) / 6. Drift: mean over 4-5 s minus mean '
              'over 1-2 s, relative to the analytic value. Oscillation: standard deviation of '
              'tip_dx over 4-5 s. Max speed: the fastest fluid particle after 1 s.', '']
-    lines += table(['scheme', 'dp', 'stable', 'static tip (mm)', 'analytic: with the plate\'s '
-                    'weight / without (mm)', 'vs analytic', 'solid alone (mm), vs it',
+    lines += table(['scheme', 'dp', 'stable', 'static tip (mm)', 'reference: 2-D FE / '
+                    'beam theory (mm)', 'vs FE / vs beam theory', 'solid alone (mm)',
+                    'coupled vs solid alone',
                     'load: force / moment vs hydrostatic', 'drift 1-2 -> 4-5 s',
                     'oscillation (mm)', 'max speed (m/s)', 'iterations', 'wall (s)', 'load'], rows)
     lines += ['', '![plate at rest](img/hard_plate_at_rest.png)', '',
-              'The solid alone (MPS) under the exact load: tip against the analytic value '
-              'without its weight (Euler-Bernoulli) and with it (the beam-column above):', '']
-    lines += table(['dp', 'particles across', 'no gravity: MPS / analytic (mm)',
-                    'with its weight: MPS / analytic (mm)'], srows)
+              'The solid alone (MPS) under the exact load: tip against the 2-D FE with the '
+              'same dead loads and against beam theory, without its weight and with it:', '']
+    lines += table(['dp', 'particles across', 'no gravity: MPS / FE / beam theory (mm)',
+                    'with its weight: MPS / FE / beam theory (mm)'], srows)
     lines += ['', 'The water\'s load on the plate held rigid (the fake solid, `--solid fake_solid`), '
               'mean over 0.5-1 s against hydrostatic:', '']
     lines += table(['dp', 'force / moment vs hydrostatic'], lrows)
     lines += ['', 'Commands:', '']
     lines += ['    ' + command(o) for o in list(outs.values()) + list(rigid.values())]
     lines += ['    ' + command(run_dir(f'rest_solid_alone_{g}{int(dp * 1e4)}'))
-              for dp in list(dps()) + [0.0015, 0.001] for g in ('', 'g_')
+              for dp in list(dps()) + SOLID_ALONE_DPS for g in ('', 'g_')
               if os.path.exists(os.path.join(run_dir(f'rest_solid_alone_{g}{int(dp * 1e4)}'), 'command.txt'))]
     lines += ['', host(outs.values()), '']
     return lines

@@ -65,7 +65,7 @@ void fluid_update_masks(struct fluid *f)
     const enum fluid_wall_bc bc = f->prm.wall_bc;
     for (size_t i = 0; i < f->ps.n; i++) {
         int t = f->type[i];
-        int tank = t == WALL_P || t == DUMMY_P, solid = t == SOLID_SURF_P || t == SOLID_INNER_P;
+        int tank = t == WALL_P || t == DUMMY_P, solid = t == SOLID_SURF_P || t == SOLID_INNER_P || t == SOLID_SUNK_P;
         f->is_fluid[i] = t == FLUID_P;
         f->has_p[i] = t == FLUID_P || t == WALL_P || t == SOLID_SURF_P;
         f->nbr_query[i] = bc == FLUID_WALL_PPE || !tank;
@@ -80,7 +80,7 @@ void fluid_update_masks(struct fluid *f)
             break;
         case FLUID_WALL_SOLID_PPE:
             f->unknown[i] = t == FLUID_P || t == SOLID_SURF_P;
-            f->ghost[i] = tank;
+            f->ghost[i] = tank || t == SOLID_SUNK_P;
             break;
         }
         /* the paper's dummies and inner solid particles carry no pressure */

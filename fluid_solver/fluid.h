@@ -25,7 +25,14 @@
 #include "mps_particles.h"
 #include "mps_timer.h"
 
-enum fluid_ptype { FLUID_P = 0, WALL_P = 1, DUMMY_P = 2, SOLID_SURF_P = 3, SOLID_INNER_P = 4 };
+enum fluid_ptype {
+    FLUID_P = 0,
+    WALL_P = 1,
+    DUMMY_P = 2,
+    SOLID_SURF_P = 3,
+    SOLID_INNER_P = 4,
+    SOLID_SUNK_P = 5 /* a solid particle inside the tank's walls: a wall particle to the fluid */
+};
 
 enum fluid_phase {
     PH_NBR, PH_PREDICT, PH_DENSITY, PH_ASSEMBLE, PH_SOLVE, PH_CORRECT, PH_SENSORS, PH_OTHER,

@@ -55,6 +55,10 @@ const struct mps_key_spec fluid_case_keys[] = {
      "coupled solid's surface in the PPE (solid_ppe), Neumann for the solid too (neumann), "
      "or the first wall layer and the solid surface in the PPE (ppe, the paper's 4.3); "
      "see docs/fluid.md"},
+    {"fluid.solid_load", MPS_KEY_ENUM, "face", 0, 0, 0, "face|eq50", "",
+     "load on a coupled solid's surface particle: its pressure times the face it stands "
+     "for (dp), along the normal from the fluid (face), or the paper's Eq. 50-51 (eq50); "
+     "see docs/pressure.md"},
     {"fluid.surface_laplacian", MPS_KEY_ENUM, "closed", 0, 0, 0, "closed|truncated", "",
      "PPE Laplacian of the particles under the free surface (Neumann walls only): "
      "neighbours missing beyond the surface extrapolated to P = 0 there (closed), or left "
@@ -263,6 +267,9 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->wall_bc = strcmp(wbc, "ppe") == 0         ? FLUID_WALL_PPE
                  : strcmp(wbc, "solid_ppe") == 0 ? FLUID_WALL_SOLID_PPE
                                                  : FLUID_WALL_NEUMANN;
+    p->solid_load = strcmp(mps_case_string(c, "fluid.solid_load"), "eq50") == 0
+                        ? FLUID_LOAD_EQ50
+                        : FLUID_LOAD_FACE;
     p->surface_closure = strcmp(mps_case_string(c, "fluid.surface_laplacian"), "closed") == 0 &&
                          p->wall_bc != FLUID_WALL_PPE;
     p->gradient_min = mps_case_bool(c, "fluid.gradient_min");

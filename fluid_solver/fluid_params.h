@@ -17,6 +17,10 @@ enum fluid_gradient { FLUID_GRAD_CORRECTED, FLUID_GRAD_PLAIN };
  * fluid (docs/fluid.md). */
 enum fluid_wall_bc { FLUID_WALL_NEUMANN, FLUID_WALL_PPE, FLUID_WALL_SOLID_PPE };
 
+/* The load on a solid surface particle (fluid_coupling.c): its pressure on
+ * its face, or the paper's Eq. 50-51. */
+enum fluid_solid_load { FLUID_LOAD_FACE, FLUID_LOAD_EQ50 };
+
 
 
 /* Probe kinds (docs/sensors.md). PRESSURE, WALL_FORCE and WALL_MOMENT are
@@ -66,6 +70,7 @@ struct fluid_params {
     double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */
     enum fluid_gradient gradient;
     enum fluid_wall_bc wall_bc;
+    enum fluid_solid_load solid_load;
     int surface_closure;          /* close the PPE Laplacian under the free surface */
     int gradient_min;             /* subtract the neighbourhood minimum pressure */
     int clamp_negative;           /* negative PPE pressures set to 0 */

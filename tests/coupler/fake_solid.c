@@ -137,8 +137,10 @@ static enum mps_status configure(void *self, const char *case_path, const char *
             s->id[k] = (int)k;
             s->x0[k][0] = b[0] + (i + 0.5) * s->dp;
             s->x0[k][1] = b[1] + (j + 0.5) * s->dp;
-            /* the bottom row stands on the floor: no water reaches it */
-            s->surface[k] = j > 0 && (i == 0 || i == nx - 1 || j == ny - 1);
+            /* the bottom face stands on the floor, but the bottom row's
+             * side faces are wet (the fluid leaves out a row sunk into the
+             * floor: fluid_coupling.c, in_walls) */
+            s->surface[k] = i == 0 || i == nx - 1 || j == ny - 1;
         }
     place(s, 0.0);
     solid_probes_locate(&s->scene, s->n, (const double(*)[2])s->x0, s->probe_n, s->probe_i);

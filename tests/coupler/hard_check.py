@@ -5,6 +5,7 @@ summary.json and probes.csv.
 usage: hard_check.py RUN_DIR --end T [--tip-bound B] [--max-iterations-mean N]
                      [--static LO HI T0 T1] [--drift D T0 T1 T2 T3] [--expect-unstable]
                      [--rigid RIGID_RUN EI LO HI] [--compare OTHER_RUN RMS]
+                     [--still-load H1 H2 DP TOL T0 T1]
 
 Stable: the coupler ended normally at time T and |tip_dx| stayed below B (m).
 --max-iterations-mean: the implicit coupling's mean iterations per step.
@@ -16,6 +17,11 @@ whose probe tip_EI is that tip times E I; EI in N m) lies in [LO, HI], both
 as running means over 10 ms.
 --compare OTHER_RUN RMS: the RMS difference of tip_dx from OTHER_RUN's over
 [0, T] is at most RMS (m).
+--still-load H1 H2 DP TOL T0 T1: the means of the probes load_fx and
+load_moment (about the plate's foot) over [T0, T1] within TOL (a fraction)
+of the still water's rho g (h1^2 - h2^2) / 2 and -rho g (h1^3 - h2^3) / 6,
+h = H - DP/2 (the fluid puts P = 0 at its top particles' centres), rho =
+1000, g = 9.81: water H1 deep left of the plate, H2 right.
 --expect-unstable: passes only if the run is NOT stable (the same case with
 the explicit scheme, to show the stable run's check can fail).
 Exit 0 if every check passes, 1 otherwise."""
@@ -49,6 +55,7 @@ def main():
     ap.add_argument('--expect-unstable', action='store_true')
     ap.add_argument('--rigid', nargs=4)
     ap.add_argument('--compare', nargs=2)
+    ap.add_argument('--still-load', nargs=6, type=float)
     a = ap.parse_args()
     s = json.load(open(os.path.join(a.run, 'summary.json')))
     d = read_probes(a.run)
@@ -88,6 +95,18 @@ def main():
               f'(band {1e3 * lo:.3f}-{1e3 * hi:.3f})')
         if not ok:
             fails.append('static deflection')
+    if a.still_load:
+        h1, h2, dp, tol, t0, t1 = a.still_load
+        h1, h2 = h1 - dp / 2, h2 - dp / 2
+        m = (t >= t0) & (t <= t1)
+        for name, exact in (('load_fx', 1000 * 9.81 * (h1 ** 2 - h2 ** 2) / 2),
+                            ('load_moment', -1000 * 9.81 * (h1 ** 3 - h2 ** 3) / 6)):
+            v = float(np.mean(d[name][m])) if m.any() else float('nan')
+            ok = abs(v / exact - 1) <= tol
+            print(('ok    ' if ok else 'FAIL  ') + f'mean {name} over {t0}-{t1} s: {v:.4f} against '
+                  f'still water {exact:.4f} ({100 * (v / exact - 1):+.1f}%, at most {100 * tol:.0f}%)')
+            if not ok:
+                fails.append(name)
     if a.drift:
         dmax, t0, t1, t2, t3 = a.drift
         v = mean(t2, t3) - mean(t0, t1)

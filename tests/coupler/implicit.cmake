@@ -34,14 +34,20 @@ set_target_properties(solid_static_load PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CM
 # tip within the plate's height (8.4 cm; measured 3.5 cm) at no more than 10
 # iterations per step on average (the issue's target; measured 7.3 and 7.9
 # with kappa_dt 5e-4 and 0, 18-19 steps accepted at the limit of 20); the
-# explicit run of the same case must not,
-# which shows the check can fail.
+# explicit run of the same case with the paper's load (Eq. 50,
+# fluid.solid_load=eq50) must not, which shows the check can fail. With the
+# face loads (the default since 2026-12-02) the explicit scheme holds this
+# plate: rho_s = 10 to 1 s, rho_s = 7 to 0.45 s (tip at most 3.7 cm), and
+# diverges at rho_s = 5 (0.135 s), where the implicit one fails too (a
+# particle thrown out of the tank at 0.216 s): Eq. 50's load, which grows as
+# the water nears the plate, had made the explicit coupling's added-mass
+# feedback far stiffer (docs/hard_cases.md).
 set(LIGHT "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_light_plate/case.yml --quiet --set dp=0.006 --set end_time=0.45 --set solid.bodies.0.rho=10 --set output.interval=0")
 add_test(NAME coupled_light_plate_implicit
          COMMAND sh -c "${LIGHT} --out ${CMAKE_BINARY_DIR}/test_out/light_implicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_implicit --end 0.45 --tip-bound 0.084 --max-iterations-mean 10"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 add_test(NAME coupled_light_plate_explicit_unstable
-         COMMAND sh -c "${LIGHT} --set coupling.scheme=explicit --out ${CMAKE_BINARY_DIR}/test_out/light_explicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_explicit --end 0.45 --tip-bound 0.084 --expect-unstable"
+         COMMAND sh -c "${LIGHT} --set coupling.scheme=explicit --set fluid.solid_load=eq50 --out ${CMAKE_BINARY_DIR}/test_out/light_explicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_explicit --end 0.45 --tip-bound 0.084 --expect-unstable"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupled_light_plate_implicit coupled_light_plate_explicit_unstable
                      PROPERTIES TIMEOUT 300 LABELS validation)
@@ -49,10 +55,12 @@ set_tests_properties(coupled_light_plate_implicit coupled_light_plate_explicit_u
 # The plate at rest (cases/hard_plate_at_rest) at 6 mm, both schemes, to 2 s.
 # At this spacing the plate is 2 particles thick: alone under the net
 # hydrostatic load it bends 8.53 mm (bench/solid_static_load.c; beam theory
-# 4.28 mm), and the fluid's loads are 16% above hydrostatic, the excess at
-# the free surface (docs/hard_cases.md). Measured over 1-2 s: 11.9 mm
-# (explicit), 12.5 mm (implicit), oscillating by 0.8-1.5 mm (standard
-# deviation). The band, 8.5-14.5 mm, holds the plate at the static deflection
+# 4.28 mm; more under its own weight), and the fluid's loads on the plate
+# held rigid are 18% / 13% (force / moment) below hydrostatic with the face
+# loads (a plate thinner than the Laplacian's reach: docs/hard_cases.md; Eq.
+# 50 put them 23% / 12% above). Measured over 1-2 s: 9.9 mm (explicit),
+# 9.8 mm (implicit), oscillating by 2.1-2.5 mm (standard deviation); with
+# Eq. 50 11.9 and 12.5 mm. The band, 8.5-14.5 mm, holds the plate at the static deflection
 # its own bending and these loads give, with room for the oscillation; a plate
 # that is not held (a coupling that loses the load) or that runs away leaves it.
 foreach(scheme explicit implicit)
@@ -61,6 +69,19 @@ foreach(scheme explicit implicit)
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   set_tests_properties(coupled_plate_at_rest_${scheme} PROPERTIES TIMEOUT 300 LABELS validation)
 endforeach()
+
+# The water's load on the plate at rest held rigid (the fake solid), 3 mm, to
+# 1 s: the means over 0.5-1 s of the force and the moment about the
+# plate's foot against the still water's. Measured -1.7% / -1.5% (the
+# default fluid.solid_load: face); the paper's Eq. 50 gives +28% / +22%
+# here (the water sits 0.6-0.8 dp from the plate, and Eq. 50's lattice
+# calibration does not hold there: docs/pressure.md). The band, 5%, is three
+# times the measured error: the fluid's pressure next to the plate is
+# hydrostatic within 2%.
+add_test(NAME coupled_rigid_plate_still_load
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_plate_at_rest/case.yml --quiet --set dp=0.003 --set end_time=1 --set output.interval=0 --solid ${CMAKE_BINARY_DIR}/bin/fake_solid --out ${CMAKE_BINARY_DIR}/test_out/rest_rigid && /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/rest_rigid --end 1 --still-load 0.072 0.024 0.003 0.05 0.5 1"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupled_rigid_plate_still_load PROPERTIES TIMEOUT 120 LABELS validation)
 
 # The standard plate (cases/dambreak_elastic_plate) at 6 mm to 0.5 s (the
 # run-up and first impact, before the flow turns chaotic: docs/dambreak_plate.md)
