@@ -36,12 +36,11 @@ set_target_properties(solid_static_load PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CM
 # with kappa_dt 5e-4 and 0, 18-19 steps accepted at the limit of 20); the
 # explicit run of the same case with the paper's load (Eq. 50,
 # fluid.solid_load=eq50) must not, which shows the check can fail. With the
-# face loads (the default since 2026-12-02) the explicit scheme holds this
-# plate: rho_s = 10 to 1 s, rho_s = 7 to 0.45 s (tip at most 3.7 cm), and
-# diverges at rho_s = 5 (0.135 s), where the implicit one fails too (a
-# particle thrown out of the tank at 0.216 s): Eq. 50's load, which grows as
-# the water nears the plate, had made the explicit coupling's added-mass
-# feedback far stiffer (docs/hard_cases.md).
+# face loads (the default since 2026-12-02) the explicit run of this plate
+# happened to hold (to 1 s), though at rho_s = 8, 9 and 12 it diverges by
+# 0.15 s: below rho_s = 25 its stability is a matter of chance
+# (docs/hard_cases.md), so the check's failing run keeps Eq. 50, under which
+# it diverges.
 set(LIGHT "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_light_plate/case.yml --quiet --set dp=0.006 --set end_time=0.45 --set solid.bodies.0.rho=10 --set output.interval=0")
 add_test(NAME coupled_light_plate_implicit
          COMMAND sh -c "${LIGHT} --out ${CMAKE_BINARY_DIR}/test_out/light_implicit; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/light_implicit --end 0.45 --tip-bound 0.084 --max-iterations-mean 10"
