@@ -155,53 +155,51 @@ static void face_load(const struct fluid *f, size_t i, double re, double force[M
         force[d] = norm > 0.0 ? -f->p[i] * face * toward[d] / norm : 0.0;
 }
 
+/* Eq. 50-51 (fluid.solid_load: eq50): j* are the fluid and solid surface
+ * neighbours (walls, dummy and inner solid particles excluded), n~ their
+ * weights, normalised on a flat face of the lattice (load_scale). The
+ * pressure pushes the solid away from the fluid: the sum points into the
+ * fluid, so the force is its negative. No fluid neighbour, no load. */
+static void eq50_load(const struct fluid *f, size_t i, double re, double force[MPS_DIM])
+{
+    const double re2 = re * re, vol = pow(f->prm.dp, MPS_DIM);
+    double acc[MPS_DIM] = {0}, ntil = 0.0;
+    int fluid_nbrs = 0;
+    for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
+        int j = f->nl.j[k];
+        if (!f->is_fluid[j] && f->type[j] != SOLID_SURF_P)
+            continue; /* walls do not load the solid */
+        double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
+        if (r2 >= re2 || r2 <= 0.0)
+            continue;
+        double w = mps_weight(sqrt(r2), re), pij = 0.5 * (f->p[i] + f->p[j]);
+        ntil += w;
+        fluid_nbrs += f->is_fluid[j];
+        for (int d = 0; d < MPS_DIM; d++)
+            acc[d] += pij * dx[d] / r2 * w;
+    }
+    double s = (fluid_nbrs > 0 && ntil > 0.0) ? -2.0 * MPS_DIM / ntil * vol * f->load_scale : 0.0;
+    for (int d = 0; d < MPS_DIM; d++)
+        force[d] = s * acc[d];
+}
+
 size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
                          double (*force)[MPS_DIM], size_t max)
 {
-    const double re = f->prm.re_n * f->prm.dp, re2 = re * re;
-    const double vol = pow(f->prm.dp, MPS_DIM);
-    size_t m = 0;
-    const size_t first = f->nfixed_end;
+    const double re = f->prm.re_n * f->prm.dp;
     const int have_list = f->nl.n == f->ps.n;
-    for (size_t i = first; i < f->ps.n && m < max; i++) {
+    size_t m = 0;
+    for (size_t i = f->nfixed_end; i < f->ps.n && m < max; i++) {
         if (f->type[i] != SOLID_SURF_P)
             continue;
-        if (f->prm.solid_load == FLUID_LOAD_FACE) {
-            id[m] = f->id[i];
-            pressure[m] = f->p[i];
-            if (have_list)
-                face_load(f, i, re, force[m]);
-            else
-                memset(force[m], 0, sizeof force[m]);
-            m++;
-            continue;
-        }
-        double acc[MPS_DIM] = {0}, ntil = 0.0;
-        int fluid_nbrs = 0;
-        /* Eq. 50: j* are the fluid and solid surface neighbours (walls,
-         * dummy and inner solid particles excluded); n~ (Eq. 51) their weights. */
-        if (have_list)
-            for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
-                int j = f->nl.j[k];
-                if (!f->is_fluid[j] && f->type[j] != SOLID_SURF_P)
-                    continue; /* walls do not load the solid */
-                double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
-                if (r2 >= re2 || r2 <= 0.0)
-                    continue;
-                double w = mps_weight(sqrt(r2), re), pij = 0.5 * (f->p[i] + f->p[j]);
-                ntil += w;
-                fluid_nbrs += f->is_fluid[j];
-                for (int d = 0; d < MPS_DIM; d++)
-                    acc[d] += pij * dx[d] / r2 * w;
-            }
         id[m] = f->id[i];
         pressure[m] = f->p[i];
-        /* The pressure pushes the solid away from the fluid: the sum points
-         * into the fluid, so the force is its negative. No fluid neighbour,
-         * no load. */
-        double s = (fluid_nbrs > 0 && ntil > 0.0) ? -2.0 * MPS_DIM / ntil * vol * f->load_scale : 0.0;
-        for (int d = 0; d < MPS_DIM; d++)
-            force[m][d] = s * acc[d];
+        if (!have_list)
+            memset(force[m], 0, sizeof force[m]);
+        else if (f->prm.solid_load == FLUID_LOAD_FACE)
+            face_load(f, i, re, force[m]);
+        else
+            eq50_load(f, i, re, force[m]);
         m++;
     }
     return m;
