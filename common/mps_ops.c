@@ -13,6 +13,7 @@
 
 #define USE(in, j) (!(in)->use || (in)->use[j])
 #define QUERY(in, i) (!(in)->query || (in)->query[i])
+#define PAIR(in, k) (!(in)->pair_use || (in)->pair_use[k])
 
 void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
 {
@@ -168,7 +169,7 @@ static double grad_ref(const struct mps_ops_in *in, size_t i, const double *f, i
     const double re2 = in->re * in->re;
     for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
         int j = nl->j[k];
-        if (!USE(in, j) || f[j] >= ref)
+        if (!USE(in, j) || !PAIR(in, k) || f[j] >= ref)
             continue;
         double r2 = 0.0;
         for (int d = 0; d < MPS_DIM; d++) {
@@ -197,7 +198,7 @@ static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, 
     }
     for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
         int j = nl->j[k];
-        if (!USE(in, j))
+        if (!USE(in, j) || !PAIR(in, k))
             continue;
         double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])in->x, i, (size_t)j, dx);
         if (r2 >= re2 || r2 <= 0.0)

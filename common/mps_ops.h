@@ -18,6 +18,8 @@ struct mps_ops_in {
     double re;                       /* effective radius of this operator, m */
     const unsigned char *use;        /* neighbour mask, or NULL */
     const unsigned char *query;      /* evaluation mask, or NULL */
+    const unsigned char *pair_use;   /* per entry of nl: 0 leaves the pair out (the
+                                      * gradients only), or NULL */
 };
 
 /* Eq. 8: n_i = sum_j w(r_ij); count_i = number of j within re (count may be NULL). */

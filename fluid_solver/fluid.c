@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "fluid_ppe.h"
+#include "fluid_shadow.h"
 #include "fluid_scene.h"
 #include "mps_kernel.h"
 #include "mps_omp.h"
@@ -54,6 +55,8 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "ghost", 1, MPS_U8, (void **)&f->ghost, "", 0);
     mps_particles_add_field(ps, "grad_use", 1, MPS_U8, (void **)&f->grad_use, "", 0);
     mps_particles_add_field(ps, "grad_fallback", 1, MPS_U8, (void **)&f->fallback, "", 0);
+    mps_particles_add_field(ps, "body_normal", MPS_DIM, MPS_F64, (void **)&f->body_n, "", 0);
+    mps_particles_add_field(ps, "in_body", 1, MPS_U8, (void **)&f->in_body, "", 0);
 }
 
 void fluid_update_masks(struct fluid *f)
@@ -192,6 +195,7 @@ void fluid_destroy(struct fluid **pf)
     mps_nbr_list_free(&f->nl_tank);
     free(f->wlap);
     free(f->wcol);
+    free(f->shadow_use);
     free(f->agg);
     free(f->aggkey);
     free(f->aggmap);
@@ -613,7 +617,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 
     /* Eq. 16-17: viscosity and gravity, explicit */
     mps_timer_switch(&f->timer, PH_PREDICT);
-    struct mps_ops_in lap_in = {&f->nl, x, p->re_lap * p->dp, NULL, f->is_fluid};
+    struct mps_ops_in lap_in = {&f->nl, x, p->re_lap * p->dp, NULL, f->is_fluid, NULL};
     if (p->nu > 0.0)
         mps_ops_laplacian_vec(&lap_in, f->n0_lap, f->lambda_lap,
                               (const double(*)[MPS_DIM])f->v, f->lap);
@@ -637,7 +641,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     mps_timer_switch(&f->timer, PH_DENSITY);
     const int ghosts = p->wall_bc != FLUID_WALL_PPE;
     const unsigned char *rows = f->unknown;
-    struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
+    struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
     mps_ops_number_density(&nd_in, f->nd, f->ncount);
     const double nlim = p->beta1 * f->n0, clim = p->beta2 * f->count0;
 #pragma omp parallel for schedule(static)
@@ -645,6 +649,10 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
         f->surface[i] = rows[i] && f->nd[i] < nlim && f->ncount[i] < clim;
     if (p->surface_scan > 0.0)
         surface_scan(f);
+    if (p->body_shadow && n > f->nfixed_end) {
+        fluid_shadow_normals(f);
+        fluid_shadow_dry(f);
+    }
 
     if (p->mixed_source) {
         /* Eq. 10 on v*: fixed particles have v* = 0, solid ones their
@@ -655,7 +663,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
         for (size_t i = nf; i < n; i++)
             for (int d = 0; d < MPS_DIM; d++)
                 f->vstar[i][d] = f->v[i][d] + (f->ghost[i] ? dt : 0.0) * f->acc[i][d];
-        struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows};
+        struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
         mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
     }
 
@@ -682,7 +690,19 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     mps_timer_switch(&f->timer, PH_CORRECT);
     if (ghosts)
         fluid_ppe_boundary_pressure(f);
-    struct mps_ops_in g_in = {&f->nl_n, x, p->re_n * p->dp, f->grad_use, f->is_fluid};
+    struct mps_ops_in g_in = {&f->nl_n, x, p->re_n * p->dp, f->grad_use, f->is_fluid, NULL};
+    if (p->body_shadow && n > f->nfixed_end) {
+        size_t npairs = f->nl_n.start[f->nl_n.n];
+        if (npairs + 1 > f->cap_shadow) {
+            unsigned char *q = realloc(f->shadow_use, npairs + npairs / 2 + 16);
+            if (!q)
+                return mps_err_set(err, MPS_ENOMEM, "fluid: out of memory for %zu pairs", npairs);
+            f->shadow_use = q;
+            f->cap_shadow = npairs + npairs / 2 + 16;
+        }
+        fluid_shadow_mask(f, &f->nl_n, f->is_fluid, f->shadow_use);
+        g_in.pair_use = f->shadow_use;
+    }
     if (p->gradient == FLUID_GRAD_CORRECTED)
         mps_ops_gradient_corrected(&g_in, f->n0, f->p, p->gradient_min, 0.2, f->grad,
                                    f->fallback);

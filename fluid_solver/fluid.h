@@ -80,6 +80,10 @@ struct fluid {
                                * itself, P_j = P_i + rho g.(x_j - x_i) (Neumann) */
     unsigned char *grad_use;  /* carries a pressure the gradient uses */
     unsigned char *fallback; /* corrected gradient fell back to Eq. 9 */
+    double (*body_n)[MPS_DIM]; /* solid surface particles: unit normal away from the body's
+                                * particles, 0 if none near (fluid.body_shadow, fluid_shadow.h) */
+    unsigned char *in_body;    /* fluid particle behind the face of its nearest solid surface
+                                * particle: never shadowed (fluid_shadow.h) */
     size_t nfluid, nfixed_end;
     /* lattice constants */
     double n0, n0_lap, lambda_lap;
@@ -96,6 +100,9 @@ struct fluid {
     int *wcol;                    /* and their indices, packed from each nl row's start */
     size_t cap_wlap;
     int *nwlap;                   /* per particle: how many of them (a field) */
+    unsigned char *shadow_use;    /* per entry of nl_n: 0 if a solid stands between the
+                                   * pair (fluid.body_shadow, fluid_shadow.h) */
+    size_t cap_shadow;
     int *agg;                     /* pcg_defl: aggregate of each PPE row */
     size_t cap_agg;
     long long *aggkey;            /* scratch: cell of each row, and a cell -> aggregate map */

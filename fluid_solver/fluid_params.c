@@ -59,6 +59,11 @@ const struct mps_key_spec fluid_case_keys[] = {
      "load on a coupled solid's surface particle: its pressure times the face it stands "
      "for (dp), along the normal from the fluid (face), or the paper's Eq. 50-51 (eq50); "
      "see docs/pressure.md"},
+    {"fluid.body_shadow", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
+     "leave out of the PPE Laplacian and the pressure gradient the pairs whose line crosses "
+     "a coupled solid (the water on the two faces of a plate thinner than re_lap); false: "
+     "every pair, as in the paper. With it a light plate needs coupling.scheme: implicit "
+     "(docs/pressure.md, \"Thin bodies\")"},
     {"fluid.surface_laplacian", MPS_KEY_ENUM, "closed", 0, 0, 0, "closed|truncated", "",
      "PPE Laplacian of the particles under the free surface (Neumann walls only): "
      "neighbours missing beyond the surface extrapolated to P = 0 there (closed), or left "
@@ -270,6 +275,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->solid_load = strcmp(mps_case_string(c, "fluid.solid_load"), "eq50") == 0
                         ? FLUID_LOAD_EQ50
                         : FLUID_LOAD_FACE;
+    p->body_shadow = mps_case_bool(c, "fluid.body_shadow");
     p->surface_closure = strcmp(mps_case_string(c, "fluid.surface_laplacian"), "closed") == 0 &&
                          p->wall_bc != FLUID_WALL_PPE;
     p->gradient_min = mps_case_bool(c, "fluid.gradient_min");

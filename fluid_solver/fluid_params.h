@@ -71,6 +71,7 @@ struct fluid_params {
     enum fluid_gradient gradient;
     enum fluid_wall_bc wall_bc;
     enum fluid_solid_load solid_load;
+    int body_shadow;              /* no PPE coupling through a coupled solid (fluid_ppe.c) */
     int surface_closure;          /* close the PPE Laplacian under the free surface */
     int gradient_min;             /* subtract the neighbourhood minimum pressure */
     int clamp_negative;           /* negative PPE pressures set to 0 */

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
+#include "fluid_shadow.h"
 #include "mps_kernel.h"
 #include "mps_omp.h"
 #include "mps_simd.h"
@@ -157,6 +158,9 @@ static int row_weights(struct fluid *f, size_t i, double c, int wide, double *di
      * front. */
     double bx[MPS_WEIGHT_CHUNK], by[MPS_WEIGHT_CHUNK];
     int fb[MPS_WEIGHT_CHUNK];
+    /* the solid surface particles within re, for the shadow test */
+    int near[FLUID_SHADOW_MAX];
+    const int nnear = f->prm.body_shadow ? fluid_shadow_near(f, i, near) : -1;
     for (size_t c0 = k0; c0 < k1; c0 += MPS_WEIGHT_CHUNK) {
         const size_t len = k1 - c0 < MPS_WEIGHT_CHUNK ? k1 - c0 : MPS_WEIGHT_CHUNK;
         double *wk = wlap + (c0 - k0);
@@ -169,6 +173,10 @@ static int row_weights(struct fluid *f, size_t i, double c, int wide, double *di
             fb[k] = flag[j];
         }
         mps_weights_r2(wk, len, re, c);
+        if (nnear >= 0)
+            for (size_t k = 0; k < len; k++)
+                if (wk[k] > 0.0 && fluid_shadowed(f, i, (size_t)nj[c0 + k], near, nnear))
+                    wk[k] = 0.0;
 #ifdef MPS_HAVE_WIDE
         if (wide)
             pass1_chunk_avx512(len, nj + c0, bx, by, wk, fb, &a, wcol, wlap);

@@ -9,7 +9,11 @@
  *   - the paper's walls (fluid.wall_bc = ppe) still run;
  *   - the Verlet neighbour list holds every pair within re_lap while no
  *     particle has moved half the skin since it was built;
- *   - the AVX-512 paths assemble the PPE of the portable ones. */
+ *   - the AVX-512 paths assemble the PPE of the portable ones;
+ *   - a plate two particles thick with water on both faces: no PPE entry
+ *     couples one face's water or particles with the other's, the matrix
+ *     stays symmetric, and a fluid particle that crept into the plate keeps
+ *     its pairs (fluid.body_shadow, fluid_shadow.c). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +22,7 @@
 #include "../test_util.h"
 #include "fluid.h"
 #include "fluid_ppe.h"
+#include "fluid_shadow.h"
 #include "mps_case.h"
 #include "mps_kernel.h"
 #include "mps_simd.h"
@@ -534,6 +539,105 @@ static void test_simd_paths(void)
 /* `test_fluid_step avx512` runs only the AVX-512 comparison (ctest
  * test_fluid_step_avx512), and reports SKIPPED (77) where there is no AVX-512
  * path to compare (the CPU lacks it, or MPS_SIMD=sse2). */
+
+/* The rigid plate of cases/hard_plate_at_rest at 6 mm, two particles thick
+ * (x 0.294-0.306), water 72 mm deep left of it and 24 mm right. With the
+ * shadow no PPE row of the left face (water or plate particles) holds an
+ * entry of the right face's, and the other way; without it there are some
+ * (so this test can fail). The matrix must stay exactly symmetric. */
+static int shadow_cross_entries(const struct fluid *f, int *asym)
+{
+    const double xl = 0.294, xr = 0.306, top = 0.084;
+    int *part = malloc((size_t)(f->nrows > 0 ? f->nrows : 1) * sizeof *part);
+    int cross = 0;
+    *asym = 0;
+    if (!part)
+        return -1;
+    for (size_t i = 0; i < f->ps.n; i++)
+        if (f->row[i] >= 0)
+            part[f->row[i]] = (int)i;
+    for (int r = 0; r < f->nrows; r++) {
+        const double *xi = f->x[part[r]];
+        for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++) {
+            const int c = f->col[k];
+            const double *xj = f->x[part[c]];
+            /* left of the mid-plane against right of it, both below the top */
+            if (xi[1] < top - f->prm.dp && xj[1] < top - f->prm.dp &&
+                (xi[0] - 0.5 * (xl + xr)) * (xj[0] - 0.5 * (xl + xr)) < 0.0)
+                cross++;
+            int found = 0;
+            for (int q = f->rowptr[c]; q < f->rowptr[c + 1]; q++)
+                if (f->col[q] == r)
+                    found = f->val[q] == f->val[k];
+            *asym += !found;
+        }
+    }
+    free(part);
+    return cross;
+}
+
+static void test_body_shadow(void)
+{
+    const double dp = 0.006;
+    enum { NX = 2, NY = 14 };
+    int id[NX * NY];
+    double xs[NX * NY][MPS_DIM], vs[NX * NY][MPS_DIM] = {{0}};
+    unsigned char surf[NX * NY];
+    for (int i = 0; i < NX; i++)
+        for (int j = 0; j < NY; j++) {
+            int k = i * NY + j;
+            id[k] = k;
+            xs[k][0] = 0.294 + (i + 0.5) * dp;
+            xs[k][1] = (j + 0.5) * dp;
+            surf[k] = 1;
+        }
+    for (int shadow = 1; shadow >= 0; shadow--) {
+        const char *sets[] = {"dp=0.006", shadow ? "fluid.body_shadow=true" : "fluid.body_shadow=false"};
+        struct fluid *f = make("cases/hard_plate_at_rest/case.yml", sets, 2);
+        CHECK(f != NULL);
+        if (!f)
+            continue;
+        struct mps_err err = {0};
+        CHECK(fluid_set_solid(f, NX * NY, id, (const double(*)[MPS_DIM])xs,
+                              (const double(*)[MPS_DIM])vs, surf, &err) == MPS_OK);
+        CHECK(step(f, 1e-3) == MPS_OK);
+        CHECK(fluid_ppe_assemble(f, 1e-3, &err) == MPS_OK);
+        int asym = 0, cross = shadow_cross_entries(f, &asym);
+        printf("body_shadow %d: %d PPE entries across the plate, %d not symmetric\n", shadow,
+               cross, asym);
+        CHECK(asym == 0);
+        CHECK(shadow ? cross == 0 : cross > 50);
+        if (shadow) {
+            /* the faces' normals point into their water */
+            int bad = 0;
+            for (size_t i = f->nfixed_end; i < f->ps.n; i++)
+                if (f->type[i] == SOLID_SURF_P && f->x[i][1] > 2 * dp && f->x[i][1] < 0.07)
+                    bad += f->body_n[i][0] * (f->x[i][0] < 0.3 ? -1.0 : 1.0) < 0.99;
+            CHECK(bad == 0);
+            /* a left water particle pushed 0.25 dp into the plate keeps its
+             * pairs; its neighbour still does not see the right water */
+            size_t k = nearest_fluid(f, 0.291, 0.033), o = nearest_fluid(f, 0.291, 0.009),
+                   r = nearest_fluid(f, 0.309, 0.009);
+            f->x[k][0] = 0.2985;
+            fluid_shadow_normals(f);
+            CHECK(f->in_body[k] == 1 && f->in_body[o] == 0);
+            int near[FLUID_SHADOW_MAX], cut = 0, pairs = 0;
+            int nn = fluid_shadow_near(f, k, near);
+            for (size_t q = f->nl.start[k]; q < f->nl.start[k + 1]; q++)
+                cut += nn >= 0 && fluid_shadowed(f, k, (size_t)f->nl.j[q], near, nn);
+            CHECK(cut == 0);
+            nn = fluid_shadow_near(f, o, near);
+            for (size_t q = f->nl.start[o]; q < f->nl.start[o + 1]; q++)
+                if ((size_t)f->nl.j[q] == r) {
+                    pairs++;
+                    CHECK(nn >= 0 && fluid_shadowed(f, o, r, near, nn));
+                }
+            CHECK(pairs == 1);
+        }
+        fluid_destroy(&f);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -552,5 +656,6 @@ int main(int argc, char **argv)
     test_ppe_terms();
     test_verlet_list();
     test_surface_double_check();
+    test_body_shadow();
     return test_summary("test_fluid_step");
 }

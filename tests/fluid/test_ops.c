@@ -97,8 +97,8 @@ static void test_regular(void)
         v[k][0] = 1.0 + 4.0 * L.x[k][0] - 2.0 * L.x[k][1]; /* div v = 4 + 3 = 7 */
         v[k][1] = -1.0 + 1.0 * L.x[k][0] + 3.0 * L.x[k][1];
     }
-    struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, ren, NULL, NULL};
-    struct mps_ops_in inl = {&L.ll, (const double(*)[MPS_DIM])L.x, rel, NULL, NULL};
+    struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, ren, NULL, NULL, NULL};
+    struct mps_ops_in inl = {&L.ll, (const double(*)[MPS_DIM])L.x, rel, NULL, NULL, NULL};
 
     /* Eq. 8 */
     mps_ops_number_density(&in, nd, cnt);
@@ -179,8 +179,8 @@ static void test_perturbed(double jitter)
         f[k] = linear(L.x[k]);
         q[k] = L.x[k][0] * L.x[k][0] + L.x[k][1] * L.x[k][1];
     }
-    struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, ren, NULL, NULL};
-    struct mps_ops_in inl = {&L.ll, (const double(*)[MPS_DIM])L.x, rel, NULL, NULL};
+    struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, ren, NULL, NULL, NULL};
+    struct mps_ops_in inl = {&L.ll, (const double(*)[MPS_DIM])L.x, rel, NULL, NULL, NULL};
     const double gmag = hypot(GX, GY);
 
     /* Eq. 14-15 stay exact for a linear field on any neighbourhood that spans
@@ -254,7 +254,7 @@ static void test_laplacian_vec(void)
         use[k] = k % 3 != 0;
         query[k] = k % 2 == 0;
     }
-    struct mps_ops_in inl = {&L.ll, (const double(*)[MPS_DIM])L.x, rel, use, query};
+    struct mps_ops_in inl = {&L.ll, (const double(*)[MPS_DIM])L.x, rel, use, query, NULL};
     mps_ops_laplacian(&inl, cl.n0, cl.lambda, c0, l0);
     mps_ops_laplacian(&inl, cl.n0, cl.lambda, c1, l1);
     double big = 0.0;

@@ -123,6 +123,17 @@ FAULTS = [
       new='double cfl = 1.1 * f->prm.courant * f->prm.dp / sqrt(vmax2);',
       what='the Courant step 10% above C dp / |v|max',
       hint='test_fluid_step'),
+    # fluid.body_shadow (fluid_shadow.c): pairs across a thin body
+    F(id='shadow_off', eq='section 4.5 (the solid surface in the PPE)', file='fluid_solver/fluid_ppe.c',
+      old='                    wk[k] = 0.0;',
+      new='                    wk[k] = 1.0 * wk[k];',
+      what='the PPE Laplacian couples the two faces of a thin plate again',
+      hint='test_fluid_step|coupled_rigid_plate_still_load_6mm'),
+    F(id='shadow_in_body', eq='section 4.5 (the solid surface in the PPE)', file='fluid_solver/fluid_shadow.c',
+      old='    if ((a < f->nfluid && f->in_body[a]) || (b < f->nfluid && f->in_body[b]))',
+      new='    if ((a < f->nfluid && f->in_body[a] && 0) || (b < f->nfluid && f->in_body[b] && 0))',
+      what='a fluid particle that crept into a body is cut off from its water',
+      hint='test_fluid_step'),
     # ---- coupling (Eq. 49-51) ----
     # the load on a solid surface particle: -P_i dp n (fluid.solid_load: face,
     # the default since 2026-12-02; Eq. 50-51 is the eq50 option, and its
