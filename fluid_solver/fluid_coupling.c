@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "fluid.h"
+#include "fluid_shadow.h"
 #include "mps_kernel.h"
 
 /* Eq. 50 on the initial lattice, for a surface particle of a flat solid face
@@ -124,28 +125,23 @@ enum mps_status fluid_set_solid(struct fluid *f, size_t n, const int *id,
 static void face_load(const struct fluid *f, size_t i, double re, double force[MPS_DIM])
 {
     const double re2 = re * re;
-    double out[MPS_DIM] = {0}, toward[MPS_DIM] = {0};
-    for (int pass = 0; pass < 2; pass++)
-        for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
-            int j = f->nl.j[k];
-            int solid = f->type[j] >= SOLID_SURF_P;
-            if (pass == 0 ? !solid : !f->is_fluid[j])
-                continue;
-            double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
-            if (r2 >= re2 || r2 <= 0.0)
-                continue;
-            double w = mps_weight(sqrt(r2), re), side = 0.0;
-            for (int d = 0; d < MPS_DIM; d++)
-                side += dx[d] * out[d];
-            if (pass == 1 && side < 0.0)
-                continue; /* beyond the body: another face's water */
-            for (int d = 0; d < MPS_DIM; d++) {
-                if (pass == 0)
-                    out[d] -= w * dx[d];
-                else
-                    toward[d] += w * dx[d];
-            }
-        }
+    double out[MPS_DIM], toward[MPS_DIM] = {0};
+    fluid_body_outward(f, i, out);
+    for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
+        int j = f->nl.j[k];
+        if (!f->is_fluid[j])
+            continue;
+        double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
+        if (r2 >= re2 || r2 <= 0.0)
+            continue;
+        double w = mps_weight(sqrt(r2), re), side = 0.0;
+        for (int d = 0; d < MPS_DIM; d++)
+            side += dx[d] * out[d];
+        if (side < 0.0)
+            continue; /* beyond the body: another face's water */
+        for (int d = 0; d < MPS_DIM; d++)
+            toward[d] += w * dx[d];
+    }
     double norm = 0.0;
     for (int d = 0; d < MPS_DIM; d++)
         norm += toward[d] * toward[d];

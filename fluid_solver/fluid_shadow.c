@@ -32,6 +32,24 @@ static double in_front(const struct fluid *f, size_t s, const double *x)
     return e;
 }
 
+void fluid_body_outward(const struct fluid *f, size_t i, double out[MPS_DIM])
+{
+    const double re = f->prm.re_n * f->prm.dp, re2 = re * re;
+    for (int d = 0; d < MPS_DIM; d++)
+        out[d] = 0.0;
+    for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
+        int j = f->nl.j[k];
+        if (f->type[j] < SOLID_SURF_P)
+            continue;
+        double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
+        if (r2 >= re2 || r2 <= 0.0)
+            continue;
+        double w = mps_weight(sqrt(r2), re);
+        for (int d = 0; d < MPS_DIM; d++)
+            out[d] -= w * dx[d];
+    }
+}
+
 void fluid_shadow_normals(struct fluid *f)
 {
     const double re = f->prm.re_n * f->prm.dp, re2 = re * re;
@@ -39,17 +57,7 @@ void fluid_shadow_normals(struct fluid *f)
     for (size_t i = f->nfixed_end; i < f->ps.n; i++) {
         double out[MPS_DIM] = {0}, norm = 0.0;
         if (f->type[i] == SOLID_SURF_P)
-            for (size_t k = f->nl.start[i]; k < f->nl.start[i + 1]; k++) {
-                int j = f->nl.j[k];
-                if (f->type[j] < SOLID_SURF_P)
-                    continue;
-                double dx[MPS_DIM], r2 = mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx);
-                if (r2 >= re2 || r2 <= 0.0)
-                    continue;
-                double w = mps_weight(sqrt(r2), re);
-                for (int d = 0; d < MPS_DIM; d++)
-                    out[d] -= w * dx[d];
-            }
+            fluid_body_outward(f, i, out);
         for (int d = 0; d < MPS_DIM; d++)
             norm += out[d] * out[d];
         norm = sqrt(norm);

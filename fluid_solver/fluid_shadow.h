@@ -16,6 +16,12 @@
 /* solid surface particles within re_lap of one particle: about 50 in 2-D */
 #define FLUID_SHADOW_MAX 128
 
+/* The weighted sum of the offsets from solid particle i to its solid
+ * neighbours within re_n, negated: the direction away from the body's
+ * particles (not normalised; 0 for a lone particle). The face loads
+ * (fluid_coupling.c) and the shadow's normals both use it. */
+void fluid_body_outward(const struct fluid *f, size_t i, double out[MPS_DIM]);
+
 /* f->body_n of every solid surface particle, from the solid particles
  * around it (at the current positions; needs f->nl). */
 void fluid_shadow_normals(struct fluid *f);

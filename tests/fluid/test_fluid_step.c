@@ -161,6 +161,23 @@ static void test_paper_walls(void)
     fluid_destroy(&f);
 }
 
+/* A rectangular plate of nx x ny particles on the lattice, left face at x0,
+ * standing on y = 0, ids 0.. in column order: the solid a coupled run would
+ * send. Its edge particles are surface ones; with dry_bottom the bottom row
+ * is not (it stands on the floor). */
+static void plate_lattice(double x0, double dp, int nx, int ny, int dry_bottom, int *id,
+                          double (*xs)[MPS_DIM], unsigned char *surf)
+{
+    for (int i = 0; i < nx; i++)
+        for (int j = 0; j < ny; j++) {
+            int k = i * ny + j;
+            id[k] = k;
+            xs[k][0] = x0 + (i + 0.5) * dp;
+            xs[k][1] = (j + 0.5) * dp;
+            surf[k] = (j > 0 || !dry_bottom) && (i == 0 || i == nx - 1 || j == 0 || j == ny - 1);
+        }
+}
+
 /* Still water against a rigid plate (tests/coupler/plate_in_water.yml) in
  * each wall mode: who is a PPE unknown, and the pressure the wetted plate
  * surface gets. In solid_ppe (the default) the plate surface is solved for
@@ -178,14 +195,7 @@ static void test_wall_modes(void)
     int id[NX * NY];
     double xs[NX * NY][MPS_DIM], vs[NX * NY][MPS_DIM] = {{0}};
     unsigned char surf[NX * NY];
-    for (int i = 0; i < NX; i++)
-        for (int j = 0; j < NY; j++) {
-            int k = i * NY + j;
-            id[k] = k;
-            xs[k][0] = 0.2 + (i + 0.5) * dp;
-            xs[k][1] = (j + 0.5) * dp;
-            surf[k] = j > 0 && (i == 0 || i == NX - 1 || j == NY - 1);
-        }
+    plate_lattice(0.2, dp, NX, NY, 1, id, xs, surf);
     for (int m = 0; m < 3; m++) {
         const char *sets[] = {modes[m]};
         struct fluid *f = make("tests/coupler/plate_in_water.yml", sets, 1);
@@ -583,14 +593,7 @@ static void test_body_shadow(void)
     int id[NX * NY];
     double xs[NX * NY][MPS_DIM], vs[NX * NY][MPS_DIM] = {{0}};
     unsigned char surf[NX * NY];
-    for (int i = 0; i < NX; i++)
-        for (int j = 0; j < NY; j++) {
-            int k = i * NY + j;
-            id[k] = k;
-            xs[k][0] = 0.294 + (i + 0.5) * dp;
-            xs[k][1] = (j + 0.5) * dp;
-            surf[k] = 1;
-        }
+    plate_lattice(0.294, dp, NX, NY, 0, id, xs, surf);
     for (int shadow = 1; shadow >= 0; shadow--) {
         const char *sets[] = {"dp=0.006", shadow ? "fluid.body_shadow=true" : "fluid.body_shadow=false"};
         struct fluid *f = make("cases/hard_plate_at_rest/case.yml", sets, 2);
