@@ -88,14 +88,14 @@ def run_list():
     return r
 
 
-def do_run(name, spec, out, force, extra):
+def do_run(name, spec, out, force, extra, coupler=COUPLER):
     case, sets, solid = spec
     d = os.path.join(out, name)
     sp = os.path.join(d, 'summary.json')
     if not force and os.path.exists(sp) and json.load(open(sp)).get('status') == 'ok':
         return
     os.makedirs(d, exist_ok=True)
-    cmd = [COUPLER, os.path.join(ROOT, 'cases', f'sloshing_{case}', 'case.yml'), '--out', d,
+    cmd = [coupler, os.path.join(ROOT, 'cases', f'sloshing_{case}', 'case.yml'), '--out', d,
            '--quiet']
     for s in sets + extra:
         cmd += ['--set', s]
@@ -325,6 +325,7 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('--runs', nargs='+', default=None)
     ap.add_argument('--out', default=os.path.join(ROOT, 'runs', 'sloshing'))
+    ap.add_argument('--coupler', default=COUPLER, help='the coupler to run (default: %(default)s)')
     ap.add_argument('--force', action='store_true')
     ap.add_argument('--no-run', action='store_true', help='analyse what is there')
     ap.add_argument('--set', action='append', default=[], help='extra --set for every run')
@@ -346,7 +347,7 @@ def main():
             sys.exit(f'unknown run {n} (--list)')
     if not a.no_run:
         for n in names:
-            do_run(n, runs[n], a.out, a.force, a.set)
+            do_run(n, runs[n], a.out, a.force, a.set, a.coupler)
     rows = [analyse(n, runs[n], a.out) for n in names]
     text = table(rows)
     extra = table_vs_sinusoid(rows, a.out, a.compare_window) + [phases(rows, a.out)]

@@ -92,7 +92,7 @@ int main(int argc, char **argv)
         solid_model_find(model ? model : mps_case_string(cs, "solid.model"));
     void *m = NULL;
     int rc = 1;
-    if (!sc || !ops || solid_scene_read(sc, cs, &err) || ops->create(&m, cs, &err)) {
+    if (!sc || !ops || solid_scene_read(sc, cs, &err) || solid_model_open(&ops, &m, cs, &err)) {
         fprintf(stderr, "solid_static_load: %s\n", !sc ? "out of memory" : !ops ? "unknown model"
                                                                                 : err.msg);
         goto done;
@@ -112,7 +112,9 @@ int main(int argc, char **argv)
     if (ops->interface(m, 1e30, &all, &err))
         goto done;
     const size_t n = all.n;
-    const double dp = sc->dp, x_face = sc->bodies[b].x0 + dp, x_back = sc->bodies[b].x1 - dp;
+    /* the interface is on the coupling lattice (solid.refine: solid_refine.h) */
+    const double dp = sc->dp_coupling, x_face = sc->bodies[b].x0 + dp,
+                 x_back = sc->bodies[b].x1 - dp;
     double *hydro = calloc(n, sizeof *hydro), *mass = calloc(n, sizeof *mass);
     double (*force)[MPS_DIM] = calloc(n, sizeof *force);
     int *id = malloc(n * sizeof *id);

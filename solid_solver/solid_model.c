@@ -7,6 +7,7 @@
 
 #include "mps_timer.h"
 #include "solid_mps.h"
+#include "solid_refine.h"
 #include "solid_tlsph.h"
 
 static const struct solid_model_ops *const models[] = {&solid_mps_ops, &solid_tlsph_ops, NULL};
@@ -40,5 +41,14 @@ enum mps_status solid_model_snapshot(const struct solid_model_ops *ops, void *mo
     size_t n = ops->snapshot(model, &x, f, MPS_PARTICLES_MAX_FIELDS, &nf);
     enum mps_status st = mps_h5_write(h5, t, step, n, x, f, nf, err);
     *seconds += mps_wall_seconds() - w0;
+    return st;
+}
+
+enum mps_status solid_model_open(const struct solid_model_ops **ops, void **self,
+                                 const struct mps_case *c, struct mps_err *err)
+{
+    enum mps_status st = (*ops)->create(self, c, err);
+    if (st == MPS_OK && mps_case_int(c, "solid.refine") > 1)
+        st = solid_refine_wrap(ops, self, c, err);
     return st;
 }

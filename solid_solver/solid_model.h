@@ -52,6 +52,17 @@ struct solid_loads {
     const double (*force)[MPS_DIM];
 };
 
+/* Every particle of a model, borrowed like the interface: what the
+ * refinement (solid_refine.h) needs to meet the fluid on a coarser lattice. */
+struct solid_particles_view {
+    size_t n;
+    const int *id, *body;
+    const double (*x0)[MPS_DIM];    /* initial lattice, m */
+    const double (*x)[MPS_DIM];     /* m */
+    const double (*v)[MPS_DIM];     /* m/s */
+    const unsigned char *surface, *fixed;
+};
+
 struct solid_model_ops {
     const char *name;   /* "mps", "tlsph" */
     /* Builds the bodies from the case (keys under "solid."). */
@@ -90,6 +101,8 @@ struct solid_model_ops {
     /* Optional: MPS_EINPUT, saying why, for a scene whose steps cannot be
      * repeated under implicit coupling although its state can be saved. */
     enum mps_status (*rollback_check)(const void *self, struct mps_err *err);
+    /* Optional: every particle (NULL: the model cannot run refined). */
+    void (*particles)(const void *self, struct solid_particles_view *out);
 };
 
 /* Writes the model's snapshot at time t, step into the series (the one
@@ -98,6 +111,12 @@ struct solid_model_ops {
 enum mps_status solid_model_snapshot(const struct solid_model_ops *ops, void *model,
                                      struct mps_h5_series *h5, double t, long step,
                                      double *seconds, struct mps_err *err);
+
+/* Creates the model *ops names from the case; with solid.refine > 1 wraps it
+ * in the refinement (solid_refine.h) and points *ops at the wrapper, which
+ * every later call goes through. */
+enum mps_status solid_model_open(const struct solid_model_ops **ops, void **self,
+                                 const struct mps_case *c, struct mps_err *err);
 
 /* The models compiled in, by name; NULL if unknown. */
 const struct solid_model_ops *solid_model_find(const char *name);

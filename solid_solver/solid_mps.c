@@ -696,6 +696,15 @@ static enum mps_status op_rollback_check(const void *self, struct mps_err *err)
     return MPS_OK;
 }
 
+static void op_particles(const void *self, struct solid_particles_view *out)
+{
+    const struct solid_mps *s = self;
+    *out = (struct solid_particles_view){s->n, s->id, s->body,
+                                         (const double(*)[MPS_DIM])s->x0,
+                                         (const double(*)[MPS_DIM])s->x,
+                                         (const double(*)[MPS_DIM])s->v, s->surface, s->fixed};
+}
+
 static void op_destroy(void **self)
 {
     struct solid_mps *s = *self;
@@ -717,6 +726,7 @@ const struct solid_model_ops solid_mps_ops = {
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
+    .particles = op_particles,
     .state_put = op_state_put,
     .state_get = op_state_get,
     .rollback_check = op_rollback_check,

@@ -95,7 +95,7 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     if (!p->ops && !(p->ops = solid_model_find(mps_case_string(p->cs, "solid.model"))))
         return mps_case_fail(p->cs, err, "solid.model", "unknown model (known: %s)",
                              solid_model_names());
-    if ((st = p->ops->create(&p->model, p->cs, err)))
+    if ((st = solid_model_open(&p->ops, &p->model, p->cs, err)))
         return st;
     p->depth = mps_case_double(p->cs, "solid.interface_depth") * mps_case_double(p->cs, "dp");
     int n = p->ops->probe_count(p->model);

@@ -25,6 +25,9 @@ const struct mps_key_spec solid_case_keys[] = {
     {"solid.mps.damping", MPS_KEY_DOUBLE, "0", 0, 0.5, 0, NULL, "",
      "MPS solid: damping ratio of the spin (highest) frequency, Kelvin-Voigt on the bonds; "
      "0 = the paper (solid_mps.h)"},
+    {"solid.refine", MPS_KEY_INT, "1", 1, 8, 0, NULL, "",
+     "solid particles per dp along each axis: the solid runs on a lattice this much finer than "
+     "the fluid and meets it on the dp lattice (solid_refine.h); 1 = the paper"},
     {"solid.courant", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "fraction of the stable explicit step, in (0, 1]"},
     {"solid.plane", MPS_KEY_ENUM, "strain", 0, 0, 0, "strain|stress", "",
@@ -99,8 +102,11 @@ static long lattice_count(double lo, double hi, double dp)
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
 {
     const struct solid_body_def *d = &s->bodies[b];
-    *nx = lattice_count(d->x0, d->x1, s->dp);
-    *ny = lattice_count(d->y0, d->y1, s->dp);
+    /* a scene built by hand (tests) may leave refine 0: unrefined */
+    const long k = s->refine > 1 ? s->refine : 1;
+    const double dpc = k > 1 ? s->dp_coupling : s->dp;
+    *nx = lattice_count(d->x0, d->x1, dpc) * k;
+    *ny = lattice_count(d->y0, d->y1, dpc) * k;
     if (*nx == 0 || *ny == 0)
         *nx = *ny = 0;
 }
@@ -153,7 +159,9 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
 {
     memset(s, 0, sizeof *s);
     char key[128];
-    s->dp = mps_case_double(c, "dp");
+    s->dp_coupling = mps_case_double(c, "dp");
+    s->refine = (int)mps_case_int(c, "solid.refine");
+    s->dp = s->dp_coupling / s->refine;
     s->g[0] = mps_case_double(c, "gravity.x");
     s->g[1] = mps_case_double(c, "gravity.y");
     s->courant = mps_case_double(c, "solid.courant");
@@ -168,6 +176,12 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
                      : strcmp(v, "bodies") == 0 ? SOLID_CONTACT_BODIES
                                                 : SOLID_CONTACT_NONE;
     }
+    /* the refinement maps each coupling particle onto a fixed block of solid
+     * particles; fracture makes new surface inside a block (solid_refine.h) */
+    if (s->refine > 1 && (s->eps_max > 0.0 || s->contact != SOLID_CONTACT_NONE))
+        return mps_case_fail(c, err, "solid.refine", "%d with %s: fracture and contact run "
+                             "at the coupling's dp only (set solid.refine to 1)", s->refine,
+                             s->eps_max > 0.0 ? "solid.eps_max" : "solid.contact");
 
     s->nbodies = mps_case_count(c, "solid.bodies");
     if (s->nbodies == 0)
@@ -210,10 +224,10 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
         long nx, ny;
         solid_scene_lattice(s, b, &nx, &ny);
         if (nx == 0) {
-            int wide = d->x1 - d->x0 >= s->dp;
+            int wide = d->x1 - d->x0 >= s->dp_coupling;
             snprintf(key, sizeof key, "solid.bodies.%d.%s", b, wide ? "y1" : "x1");
             return mps_case_fail(c, err, key, "body '%s' holds no particle: it must reach at "
-                                 "least dp = %g beyond %s", d->name, s->dp,
+                                 "least dp = %g beyond %s", d->name, s->dp_coupling,
                                  wide ? "y0" : "x0");
         }
     }

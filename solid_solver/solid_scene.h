@@ -66,7 +66,10 @@ struct solid_probe_def {
 };
 
 struct solid_scene {
-    double dp;               /* lattice spacing, m */
+    double dp;               /* lattice spacing, m: the case's dp / refine */
+    double dp_coupling;      /* the case's dp, the spacing the fluid sees, m */
+    int refine;              /* solid.refine: particles per dp_coupling (solid_refine.h);
+                              * 0 or 1 (a scene built by hand): unrefined */
     double g[MPS_DIM];       /* body force per unit mass, m/s^2 */
     double courant;          /* (0, 1]: fraction of the stable step, see solid_mps.h */
     double mps_damping;      /* MPS solid: damping ratio at the spin frequency (solid_mps.h) */
@@ -120,7 +123,9 @@ enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, 
                                   const struct solid_loads *f, double (*aload)[MPS_DIM],
                                   struct mps_err *err);
 
-/* Lattice columns and rows of body b (0 if it holds no particle). */
+/* Lattice columns and rows of body b (0 if it holds no particle): refine
+ * times those of the case's dp, so each cell of the coupling lattice holds
+ * refine x refine particles and the body keeps the extent it has at dp. */
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny);
 
 /* Lame constants of body b, Pa (Eq. 4, or plane stress, see enum solid_plane). */

@@ -782,6 +782,15 @@ static enum mps_status op_state_get(void *self, struct mps_ckpt *c, struct mps_e
     return MPS_OK;
 }
 
+static void op_particles(const void *self, struct solid_particles_view *out)
+{
+    const struct solid_tlsph *s = self;
+    *out = (struct solid_particles_view){s->n, s->id, s->body,
+                                         (const double(*)[MPS_DIM])s->x0,
+                                         (const double(*)[MPS_DIM])s->x,
+                                         (const double(*)[MPS_DIM])s->v, s->surface, s->fixed};
+}
+
 static void op_destroy(void **self)
 {
     struct solid_tlsph *s = *self;
@@ -803,6 +812,7 @@ const struct solid_model_ops solid_tlsph_ops = {
     .snapshot = op_snapshot,
     .summary = op_summary,
     .destroy = op_destroy,
+    .particles = op_particles,
     .state_put = op_state_put,
     .state_get = op_state_get,
 };

@@ -8,6 +8,12 @@ foreach(model mps tlsph)
            COMMAND ${CONFORMANCE} --solid "${CMAKE_BINARY_DIR}/bin/solid_solver --model ${model}"
            WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 endforeach()
+# The MPS solid refined (solid.refine, solid_refine.h): the same conversation
+# and rollback on the coupling lattice, the solid twice as fine behind it.
+add_test(NAME conformance_solid_mps_refined
+         COMMAND ${CONFORMANCE} --solid "${CMAKE_BINARY_DIR}/bin/solid_solver --model mps"
+                 --set solid.refine=2
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 add_test(NAME conformance_solid_python
          COMMAND ${CONFORMANCE}
                  --solid "/usr/bin/python3 ${CMAKE_SOURCE_DIR}/solid_solver/python/modal_beam_solid.py"
@@ -34,6 +40,7 @@ foreach(case "step;;result\\.echo" "abort;;abort\\.exit" "silent;;malformed\\.ba
 endforeach()
 
 set_tests_properties(conformance_solid_mps conformance_solid_tlsph conformance_solid_python
+                     conformance_solid_mps_refined
                      conformance_toy_solid conformance_toy_solid_rollback
                      conformance_catches_bug_step conformance_catches_bug_abort
                      conformance_catches_bug_silent conformance_catches_bug_role

@@ -1,7 +1,7 @@
 # Solid solver tests: unit (operators, model, stability, conservation),
 # integration (the program: outputs, bad input) and validation (cantilever).
 set(SOLID_TEST_DIR ${CMAKE_CURRENT_LIST_DIR})
-foreach(t operators model stability conservation damping stress)
+foreach(t operators model stability conservation damping stress refine)
   mps_add_test(test_solid_${t} SOURCES ${SOLID_TEST_DIR}/test_solid_${t}.c LIBS solidcore
     LABELS unit TIMEOUT 60)
   target_include_directories(test_solid_${t} PRIVATE ${CMAKE_SOURCE_DIR}/tests)
