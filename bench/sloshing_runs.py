@@ -109,16 +109,25 @@ def do_run(name, spec, out, force, extra, coupler=COUPLER):
     subprocess.run(cmd)
 
 
-def cycles(t, x, lo, hi):
+def cycles(t, x, lo, hi, band=0.5):
     """Cycles of x between up-crossings of its mean over [lo, hi]: list of
-    (t_start, t_end, max, min)."""
+    (t_start, t_end, max, min). An up-crossing counts only after x has been
+    below the mean by band x its standard deviation since the last one: a
+    refined plate (solid.refine) rings at its own ~10 Hz on top of the roll's
+    period, and each ripple through the mean would otherwise start a cycle
+    (a sinusoid's crossings are untouched: it dips to -1.4 std)."""
     m = (t >= lo) & (t <= hi)
     tt, xx = t[m], x[m]
     if len(tt) < 3:
         return []
     s = xx - xx.mean()
-    up = [tt[k] - s[k] * (tt[k + 1] - tt[k]) / (s[k + 1] - s[k])
-          for k in range(len(s) - 1) if s[k] < 0 <= s[k + 1]]
+    h = band * float(s.std())
+    up, armed = [], False
+    for k in range(len(s) - 1):
+        armed = armed or s[k] < -h
+        if armed and s[k] < 0 <= s[k + 1]:
+            up.append(tt[k] - s[k] * (tt[k + 1] - tt[k]) / (s[k + 1] - s[k]))
+            armed = False
     out = []
     for a, b in zip(up[:-1], up[1:]):
         k = (tt >= a) & (tt <= b)

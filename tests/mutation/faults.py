@@ -124,6 +124,19 @@ FAULTS = [
       what='the Courant step 10% above C dp / |v|max',
       hint='test_fluid_step'),
     # fluid.body_shadow (fluid_shadow.c): pairs across a thin body
+    # solid.refine (solid_refine.c): the map between the two lattices
+    F(id='refine_load_share', eq='Eq. 50 (the load on the solid)', file='solid_solver/solid_refine.c',
+      old='                r->load_f[m][a] = f->force[k][a] / (double)(e1 - e0);',
+      new='                r->load_f[m][a] = 0.9 * f->force[k][a] / (double)(e1 - e0);',
+      what='a refined solid gets 10% less of the load the fluid sent',
+      hint='test_solid_refine'),
+    F(id='refine_mean_off_by_one', eq='the coupling interface (solid_refine.h)', file='solid_solver/solid_refine.c',
+      old="""        double x[MPS_DIM] = {0}, v[MPS_DIM] = {0};
+        for (size_t e = b0; e < b1; e++)""",
+      new="""        double x[MPS_DIM] = {0}, v[MPS_DIM] = {0};
+        for (size_t e = b0 + 1; e < b1; e++)""",
+      what='a coupling particle\'s position leaves one particle of its block out of the mean',
+      hint='test_solid_refine'),
     F(id='shadow_off', eq='section 4.5 (the solid surface in the PPE)', file='fluid_solver/fluid_ppe.c',
       old='                    wk[k] = 0.0;',
       new='                    wk[k] = 1.0 * wk[k];',
