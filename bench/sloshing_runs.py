@@ -165,6 +165,9 @@ def analyse(name, spec, out):
     res['n_fluid'] = fl['particles']['fluid']
     res['n_solid_iface'] = fl['particles']['solid']
     res['substeps'] = so.get('substeps', 0)
+    ms = so.get('model_summary', {})
+    if ms.get('refine', 1) > 1:  # solid.refine: the solid k times finer than the fluid
+        res['model'] += f", refine {ms['refine']}"
     res['lost'] = fl.get('lost_particles', 0)
     res['guard'] = fl.get('wall_guard_uses', 0)
     res['escaped'] = float(p['escaped'].max())
