@@ -218,10 +218,11 @@ static enum mps_status op_interface(void *self, double depth, struct solid_iface
         if (st)
             return st;
     }
+    /* only the coupling particles the interface holds: the rest stay unread */
     struct solid_particles_view pv;
     r->inner->particles(r->model, &pv);
-    for (size_t c = 0; c < r->nc; c++) {
-        const size_t b0 = r->block_start[c], b1 = r->block_start[c + 1];
+    for (size_t k = 0; k < r->iface.n; k++) {
+        const size_t c = r->iface.idx[k], b0 = r->block_start[c], b1 = r->block_start[c + 1];
         double x[MPS_DIM] = {0}, v[MPS_DIM] = {0};
         for (size_t e = b0; e < b1; e++)
             for (int a = 0; a < MPS_DIM; a++) {
