@@ -85,6 +85,9 @@ def run_list():
     for case in ('low', 'high'):
         r[f'{case}_1_mps_implicit'] = (case, ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
                                               'output.interval=0.1'], None)
+        r[f'{case}_0.8_mps_implicit'] = (case, ['dp=0.0008', 'fluid.dt_max=5e-4',
+                                                'coupling.scheme=implicit', 'output.interval=0.1'],
+                                         None)
     return r
 
 

@@ -1,0 +1,75 @@
+#!/usr/bin/python3
+"""The plate at rest's drift (issue 18, docs/hard_cases.md section 4), with how
+well one run can know it.
+
+usage: bench/rest_drift.py RUN [RUN...] [--ref M] [--block S]
+
+The issue's drift is the mean tip_dx over 4-5 s minus the mean over 1-2 s.
+The plate rings with the water about its mean (the water's seiches and the
+fluid's step-to-step noise, a few tenths of a millimetre), and two one-second
+means of such a signal differ by chance. So this also fits a straight line to
+the means of blocks of --block s (0.5 s: longer than the plate's period in
+water and the left basin's first seiche, 0.77 s, is not) over 1-5 s and
+gives its slope over the 4 s with the standard error of that slope from the
+blocks' scatter about the line (blocks taken as independent). A drift is
+resolved only where it exceeds about twice its standard error.
+--fe: the static deflection the mean over 4-5 s is compared with, m (default:
+the converged FE's at 3 mm, 5.7275 mm, bench/plate_fe_reference.json);
+--ref: the one the drift is relative to, as in hard_cases.md's table (default:
+the beam theory's at 3 mm, 5.6278 mm)."""
+import argparse
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'tests', 'coupler'))
+from hard_check import read_probes  # noqa: E402
+
+
+def drift(t, x, block=0.5, t0=1.0, t1=5.0):
+    """(mean 4-5 s - mean 1-2 s, slope fit over [t0, t1] times (t1 - t0), its
+    standard error, the blocks' residual standard deviation), all in x's unit."""
+    m12 = x[(t >= 1) & (t <= 2)].mean()
+    m45 = x[(t >= 4) & (t <= 5)].mean()
+    edges = np.arange(t0, t1 + 1e-9, block)
+    tc, xb = [], []
+    for a, b in zip(edges[:-1], edges[1:]):
+        m = (t >= a) & (t < b)
+        if m.any():
+            tc.append(0.5 * (a + b))
+            xb.append(x[m].mean())
+    tc, xb = np.array(tc), np.array(xb)
+    if len(tc) < 3:
+        return m45 - m12, float('nan'), float('nan'), float('nan')
+    A = np.vstack([np.ones_like(tc), tc - tc.mean()]).T
+    c, *_ = np.linalg.lstsq(A, xb, rcond=None)
+    r = xb - A @ c
+    s = np.sqrt(np.sum(r ** 2) / (len(tc) - 2))
+    se = s / np.sqrt(np.sum((tc - tc.mean()) ** 2))
+    return m45 - m12, c[1] * (t1 - t0), se * (t1 - t0), s
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('runs', nargs='+')
+    ap.add_argument('--fe', type=float, default=0.0057275)
+    ap.add_argument('--ref', type=float, default=0.0056278)
+    ap.add_argument('--block', type=float, default=0.5)
+    a = ap.parse_args()
+    for run in a.runs:
+        d = read_probes(run)
+        t, x = d['time'], d['tip_dx']
+        if t[-1] < 5.0 - 1e-6:
+            print(f'{run}: reached {t[-1]:.3f} s, not 5 s: no drift')
+            continue
+        d45, fit, se, s = drift(t, x, a.block)
+        m45 = x[(t >= 4) & (t <= 5)].mean()
+        print(f'{run}: mean 4-5 s {1e3 * m45:.3f} mm ({100 * (m45 / a.fe - 1):+.1f}% of '
+              f'{1e3 * a.fe:.3f}); drift 1-2 -> 4-5 s {100 * d45 / a.ref:+.2f}%; '
+              f'fit over 1-5 s {100 * fit / a.ref:+.2f}% +- {100 * se / a.ref:.2f}% '
+              f'({a.block:g} s blocks scatter {1e3 * s:.3f} mm)')
+
+
+if __name__ == '__main__':
+    main()
