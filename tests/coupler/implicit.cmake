@@ -137,3 +137,10 @@ add_test(NAME gate_static_mps
          COMMAND /usr/bin/python3 tests/coupler/gate_static_check.py ${CMAKE_BINARY_DIR} mps 0.001 0.97 1.03
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(gate_static_mps PROPERTIES TIMEOUT 240 LABELS validation)
+
+# bench/rest_drift.py's estimate of the plate at rest's drift (docs/hard_cases.md,
+# "The drift, measured again") on synthetic tips whose creep is known.
+add_test(NAME bench_rest_drift
+         COMMAND /usr/bin/python3 tests/coupler/test_rest_drift.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(bench_rest_drift PROPERTIES TIMEOUT 60)
