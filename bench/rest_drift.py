@@ -2,7 +2,7 @@
 """The plate at rest's drift (issue 18, docs/hard_cases.md section 4), with how
 well one run can know it.
 
-usage: bench/rest_drift.py RUN [RUN...] [--ref M] [--block S]
+usage: bench/rest_drift.py RUN [RUN...] [--fe M] [--ref M] [--block S] [--fit-end T]
 
 The issue's drift is the mean tip_dx over 4-5 s minus the mean over 1-2 s.
 The plate rings with the water about its mean (the water's seiches and the
@@ -28,8 +28,9 @@ from hard_check import read_probes  # noqa: E402
 
 
 def drift(t, x, block=0.5, t0=1.0, t1=5.0):
-    """(mean 4-5 s - mean 1-2 s, slope fit over [t0, t1] times (t1 - t0), its
-    standard error, the blocks' residual standard deviation), all in x's unit."""
+    """(mean 4-5 s, mean 4-5 s - mean 1-2 s, slope fit over [t0, t1] times
+    (t1 - t0), its standard error, the blocks' residual standard deviation),
+    all in x's unit."""
     m12 = x[(t >= 1) & (t <= 2)].mean()
     m45 = x[(t >= 4) & (t <= 5)].mean()
     edges = np.arange(t0, t1 + 1e-9, block)
@@ -41,13 +42,13 @@ def drift(t, x, block=0.5, t0=1.0, t1=5.0):
             xb.append(x[m].mean())
     tc, xb = np.array(tc), np.array(xb)
     if len(tc) < 3:
-        return m45 - m12, float('nan'), float('nan'), float('nan')
+        return m45, m45 - m12, float('nan'), float('nan'), float('nan')
     A = np.vstack([np.ones_like(tc), tc - tc.mean()]).T
     c, *_ = np.linalg.lstsq(A, xb, rcond=None)
     r = xb - A @ c
     s = np.sqrt(np.sum(r ** 2) / (len(tc) - 2))
     se = s / np.sqrt(np.sum((tc - tc.mean()) ** 2))
-    return m45 - m12, c[1] * (t1 - t0), se * (t1 - t0), s
+    return m45, m45 - m12, c[1] * (t1 - t0), se * (t1 - t0), s
 
 
 def main():
@@ -66,9 +67,8 @@ def main():
         if t[-1] < max(5.0, a.fit_end) - 1e-6:
             print(f'{run}: reached {t[-1]:.3f} s, not {max(5.0, a.fit_end):g} s: no drift')
             continue
-        d45, fit, se, s = drift(t, x, a.block, t1=a.fit_end)
+        m45, d45, fit, se, s = drift(t, x, a.block, t1=a.fit_end)
         fit, se = fit * 4.0 / (a.fit_end - 1.0), se * 4.0 / (a.fit_end - 1.0)
-        m45 = x[(t >= 4) & (t <= 5)].mean()
         print(f'{run}: mean 4-5 s {1e3 * m45:.3f} mm ({100 * (m45 / a.fe - 1):+.1f}% of '
               f'{1e3 * a.fe:.3f}); drift 1-2 -> 4-5 s {100 * d45 / a.ref:+.2f}%; '
               f'fit over 1-{a.fit_end:g} s, per 4 s: {100 * fit / a.ref:+.2f}% +- {100 * se / a.ref:.2f}% '

@@ -27,16 +27,16 @@ def main():
     t = np.arange(0, 9.0001, 0.005)
     fails = []
     creep = 0.01 * 5.6e-3
-    _, fit9, se9, _ = drift(t, signal(creep, t), 0.5, t1=9.0)
+    _, _, fit9, se9, _ = drift(t, signal(creep, t), 0.5, t1=9.0)
     fit9, se9 = fit9 * 4 / 8, se9 * 4 / 8
     print(f'creep {1e6 * creep:.1f} um per 4 s: fit 1-9 s {1e6 * fit9:.1f} +- {1e6 * se9:.1f} um')
     if abs(fit9 - creep) > 3 * se9 or se9 >= creep:
         fails.append('the 9-s fit does not resolve a 1% creep')
-    d45, fit5, se5, _ = drift(t, signal(creep, t), 0.5, t1=5.0)
+    _, d45, fit5, se5, _ = drift(t, signal(creep, t), 0.5, t1=5.0)
     print(f'over 1-5 s: fit {1e6 * fit5:.1f} +- {1e6 * se5:.1f} um, two 1-s means {1e6 * d45:.1f} um')
     if se5 <= creep * 0.5:
         fails.append('the 5-s fit claims more precision than such a ring allows')
-    _, fit0, se0, _ = drift(t, signal(0.0, t), 0.5, t1=9.0)
+    _, _, fit0, se0, _ = drift(t, signal(0.0, t), 0.5, t1=9.0)
     print(f'no creep: fit 1-9 s {1e6 * fit0 * 0.5:.1f} +- {1e6 * se0 * 0.5:.1f} um')
     if abs(fit0) > 3 * se0:
         fails.append('a still plate reads as drifting')
