@@ -18,7 +18,8 @@ mean distance to their 4 nearest, in dp: how the lattice rearranges.
 random by 0.02-0.15 dp, at the same area, against the perfect lattice's (re =
 2.1 dp, the MPS weight re/r - 1): the weight is convex in r, so disorder
 raises the number density, and a correction that holds it at n0 then expands
-the water by about as much."""
+the water by about as much; beside it, the quadratic weight of
+fluid.density_weight = quadratic, which disorder raises about a third as much."""
 import argparse
 import glob
 import os
@@ -68,21 +69,23 @@ def spacing(x, sel, dp):
 
 
 def jitter_table(re=2.1, n=40, seed=1):
-    """n/n0 of a periodic square lattice (spacing 1) jittered by sigma."""
+    """n/n0 of a periodic square lattice (spacing 1) jittered by sigma, for
+    Eq. 7's weight and for the quadratic one of fluid.density_weight
+    ((1 - r/re)^2, the particle itself included)."""
     rng = np.random.default_rng(seed)
     g = np.stack(np.meshgrid(np.arange(n), np.arange(n)), -1).reshape(-1, 2).astype(float)
 
     def mean_n(x):
-        tot = 0.0
+        tot = np.zeros(2)
         for c in range(0, len(x), 400):
             d = x[c:c + 400, None, :] - x[None, :, :]
             d -= n * np.round(d / n)
             r = np.hypot(d[..., 0], d[..., 1])
             m = (r > 0) & (r < re)
-            tot += np.sum(re / r[m] - 1)
-        return tot / len(x)
+            tot += [np.sum(re / r[m] - 1), np.sum((1 - r[m] / re) ** 2)]
+        return tot / len(x) + [0.0, 1.0]
     n0 = mean_n(g)
-    return [(s, mean_n((g + s * rng.standard_normal(g.shape)) % n) / n0)
+    return [(s, *(mean_n((g + s * rng.standard_normal(g.shape)) % n) / n0))
             for s in (0.02, 0.05, 0.1, 0.15)]
 
 
@@ -95,9 +98,9 @@ def main():
     ap.add_argument('--jitter', action='store_true')
     a = ap.parse_args()
     if a.jitter:
-        for sig, ratio in jitter_table():
+        for sig, ratio, quad in jitter_table():
             print(f'square lattice jittered by {sig:.2f} dp: number density {100 * (ratio - 1):+.2f}% '
-                  'at the same area')
+                  f'at the same area (quadratic weight: {100 * (quad - 1):+.2f}%)')
     r = rows(a.run, a.x0, a.x1, a.dp)
     if not r:
         raise SystemExit(f'{a.run}: no fluid snapshot (fluid_*.h5)')

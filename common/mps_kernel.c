@@ -33,6 +33,20 @@ struct mps_lattice_consts mps_lattice_consts(double l0, double re)
     return c;
 }
 
+double mps_lattice_n0_quadratic(double l0, double re)
+{
+    int k = (int)ceil(re / l0) + 1;
+    double sum_w = 0.0;
+#if MPS_DIM == 2
+    for (int a = -k; a <= k; a++)
+        for (int b = -k; b <= k; b++)
+            sum_w += mps_weight_quadratic(l0 * sqrt((double)(a * a + b * b)), re);
+#else
+#error "mps_lattice_n0_quadratic: only MPS_DIM == 2 is implemented"
+#endif
+    return sum_w;
+}
+
 void mps_weights_r2_sse2(double *restrict w, size_t n, double re, double scale)
 {
     size_t k = 0;

@@ -44,6 +44,22 @@ int mps_weights_r2_wide(double *restrict w, size_t n, double re, double scale);
  * many candidates, with stack buffers of this size. */
 #define MPS_WEIGHT_CHUNK 128
 
+/* The smooth weight (1 - r/re)^2 for 0 <= r < re, the particle itself
+ * included (w(0) = 1), that fluid.density_weight = quadratic uses for Eq.
+ * 23's density error. Eq. 7's weight is convex (re/r - 1 grows without
+ * bound as r -> 0), so a disordered lattice has a higher number density than
+ * an ordered one at the same area (+3.3% for a lattice jittered by 0.1 dp):
+ * a correction that holds it at n0 expands water that loses its order. The
+ * quadratic weight is nearly flat in that sense (+1.0%), yet still peaked
+ * at r = 0, so a closing pair still raises it (a weight with a flat top,
+ * as the cubic spline, let still water pair up within 0.5 s at 0.2 ms
+ * steps). docs/pressure.md, "Still water, 10 s". */
+static inline double mps_weight_quadratic(double r, double re)
+{
+    double q = 1.0 - r / re;
+    return (r >= 0.0 && q > 0.0) ? q * q : 0.0;
+}
+
 struct mps_lattice_consts {
     double n0;       /* Eq. 8 on the full square lattice */
     double lambda;   /* Eq. 13, m^2 */
@@ -53,5 +69,9 @@ struct mps_lattice_consts {
 /* Constants for a particle inside a full square lattice of spacing l0, with
  * effective radius re (both in m). */
 struct mps_lattice_consts mps_lattice_consts(double l0, double re);
+
+/* The sum of mps_weight_quadratic over the same lattice, the particle
+ * itself included: the reference of mps_ops_density_quadratic. */
+double mps_lattice_n0_quadratic(double l0, double re);
 
 #endif

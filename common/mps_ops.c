@@ -15,7 +15,9 @@
 #define QUERY(in, i) (!(in)->query || (in)->query[i])
 #define PAIR(in, k) (!(in)->pair_use || (in)->pair_use[k])
 
-void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
+/* Eq. 8's sum (quadratic = 0), or that of mps_weight_quadratic with the
+ * particle itself (quadratic = 1) */
+static void density_sum(const struct mps_ops_in *in, double *n, int *count, int quadratic)
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re;
@@ -23,7 +25,7 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
-        double s = 0.0;
+        double s = quadratic ? 1.0 : 0.0;
         int c = 0;
         for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
             int j = nl->j[k];
@@ -35,7 +37,8 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
                 r2 += dx * dx;
             }
             if (r2 < re2) {
-                s += mps_weight(sqrt(r2), in->re);
+                double r = sqrt(r2);
+                s += quadratic ? mps_weight_quadratic(r, in->re) : mps_weight(r, in->re);
                 c++;
             }
         }
@@ -43,6 +46,16 @@ void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
         if (count)
             count[i] = c;
     }
+}
+
+void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
+{
+    density_sum(in, n, count, 0);
+}
+
+void mps_ops_density_quadratic(const struct mps_ops_in *in, double *n)
+{
+    density_sum(in, n, NULL, 1);
 }
 
 #ifdef OPS_WIDE

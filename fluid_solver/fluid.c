@@ -44,6 +44,7 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "grad_p", MPS_DIM, MPS_F64, (void **)&f->grad, "Pa/m", 0);
     mps_particles_add_field(ps, "body_acc", MPS_DIM, MPS_F64, (void **)&f->acc, "m/s^2", 0);
     mps_particles_add_field(ps, "div_vstar", 1, MPS_F64, (void **)&f->div, "1/s", 0);
+    mps_particles_add_field(ps, "density_quadratic", 1, MPS_F64, (void **)&f->nq, "", 0);
     mps_particles_add_field(ps, "ncount", 1, MPS_I32, (void **)&f->ncount, "", 0);
     mps_particles_add_field(ps, "row", 1, MPS_I32, (void **)&f->row, "", 0);
     mps_particles_add_field(ps, "ppe_nbrs", 1, MPS_I32, (void **)&f->nwlap, "", 0);
@@ -162,6 +163,7 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     f->n0 = cn.n0;
     f->count0 = cn.count;
     f->n0_lap = cl.n0;
+    f->nq0 = mps_lattice_n0_quadratic(prm->dp, prm->re_n * prm->dp);
     f->lambda_lap = cl.lambda;
     f->skin = SKIN_FRACTION * prm->dp;
 
@@ -643,6 +645,8 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     const unsigned char *rows = f->unknown;
     struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
     mps_ops_number_density(&nd_in, f->nd, f->ncount);
+    if (p->density_quadratic)
+        mps_ops_density_quadratic(&nd_in, f->nq);
     const double nlim = p->beta1 * f->n0, clim = p->beta2 * f->count0;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++)

@@ -65,6 +65,7 @@ struct fluid {
     double *p;
     double *div;           /* divergence of v* (mixed PPE source) */
     double *nd;            /* particle number density n* (re_n) */
+    double *nq;            /* mps_ops_density_quadratic at x* (fluid.density_weight) */
     int *ncount;           /* neighbours within re_n */
     int *type;             /* enum fluid_ptype */
     int *id;               /* stable id (solid particles: the solid's id) */
@@ -87,6 +88,7 @@ struct fluid {
     size_t nfluid, nfixed_end;
     /* lattice constants */
     double n0, n0_lap, lambda_lap;
+    double nq0;            /* mps_lattice_n0_quadratic at re_n (fluid.density_weight) */
     double load_scale;     /* Eq. 50 normalisation, see fluid_coupling.c */
     int solid_placed;      /* walls under the solid removed */
     int count0;

@@ -65,6 +65,7 @@ struct fluid_params {
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
     double kappa_dt;              /* s: steps shorter than this correct kappa dt / kappa_dt */
+    int density_quadratic;        /* Eq. 23's density error from mps_weight_quadratic */
     double re_n, re_lap;          /* effective radii, multiples of dp */
     double beta1, beta2;          /* free-surface double check */
     double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */

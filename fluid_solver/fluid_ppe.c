@@ -322,8 +322,8 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         }
         cols[k] = r;
         vals[k] = diag + comp;
-        /* Eq. 23's density term */
-        double dn = f->nd[i] - f->n0;
+        /* Eq. 23's density term, its error relative to n0 either way */
+        double dn = p->density_quadratic ? f->n0 * (f->nq[i] / f->nq0 - 1.0) : f->nd[i] - f->n0;
         f->rhs[r] = ghost + src * dn;
         if (mixed) /* with Neumann walls compressibility acts on the change of
                     * pressure, see fluid_ppe.h */

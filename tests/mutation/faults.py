@@ -21,10 +21,15 @@ FAULTS = [
       what='the weight function reaches 10% beyond re (negative weights there)',
       hint='test_nbr|test_fluid_ops|test_solid_operators'),
     F(id='number_density_low', eq='Eq. 8', file='common/mps_ops.c',
-      old='                s += mps_weight(sqrt(r2), in->re);',
-      new='                s += 0.9 * mps_weight(sqrt(r2), in->re);',
+      old='                s += quadratic ? mps_weight_quadratic(r, in->re) : mps_weight(r, in->re);',
+      new='                s += quadratic ? mps_weight_quadratic(r, in->re) : 0.9 * mps_weight(r, in->re);',
       what='particle number density 10% low (the PPE source of Eq. 18/23 sees a 10% expansion)',
       hint='test_fluid_step|fluid_valid_hydrostatic'),
+    F(id='density_quadratic_low', eq='Eq. 23 (fluid.density_weight)', file='common/mps_ops.c',
+      old='                s += quadratic ? mps_weight_quadratic(r, in->re) : mps_weight(r, in->re);',
+      new='                s += quadratic ? 0.9 * mps_weight_quadratic(r, in->re) : mps_weight(r, in->re);',
+      what='the quadratic density of Eq. 23\'s option 10% low on the neighbours (a 10% expansion seen)',
+      hint='test_fluid_ops|fluid_still_water_10s'),
     F(id='gradient_plain_coef', eq='Eq. 9', file='common/mps_ops.c',
       old='''    const double coef = MPS_DIM / n0;
 #pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
