@@ -4,7 +4,7 @@
 bench/hard_cases.py rest_analytic() approximates as an Euler-Bernoulli beam.
 
 usage: bench/plate_fe.py [--dp DP ...] [--no-weight] [--nonlinear | --follower]
-                         [--both] [--dense] [--validate] [--max-nx N]
+                         [--both] [--dense] [--fixed-volume] [--validate] [--max-nx N]
 
   --dp         particle spacings (m): they set the water levels h - dp/2 and
                the probe point (default 0.003 0.0015 0.001 0.00075)
@@ -14,6 +14,10 @@ usage: bench/plate_fe.py [--dp DP ...] [--no-weight] [--nonlinear | --follower]
   --follower   nonlinear, with the water pressure at the current faces
   --both       with and without weight: linearised, nonlinear, follower
   --dense      numpy dense solves even where scipy is there (as on CI)
+  --fixed-volume  the basins are closed: the bent plate lowers the left level
+               by the room it gives that basin (its width 0.294 m) and raises
+               the right one (0.278 m), iterated; the particle runs hold
+               volumes, not levels, so this is what they should approach
   --validate   the FE's own checks: a slender cantilever against
                Euler-Bernoulli + Timoshenko shear, the self-weight buckling load
   --max-nx     the finest mesh of the sequence 2, 4, 8, ... (default 16 with
@@ -78,6 +82,10 @@ SPARSE = sps is not None   # a caller (the ctest) may set False to run as on CI
 RHO_W, G = 1000.0, 9.81
 # The plate of cases/hard_plate_at_rest (hard_cases.py REST), clamped at y = 0.
 PLATE = dict(b=0.012, L=0.084, E=1.0e6, rho_s=2500.0, h1=0.072, h2=0.024)
+# The widths of the two closed basins (the tank is 0.584 m wide, the plate's
+# faces at x = 0.294 and 0.306): what --fixed-volume divides the room the bent
+# plate gives or takes by.
+BASINS = dict(w1=0.294, w2=0.584 - 0.306)
 
 
 # ---------------------------------------------------------------- the Q9 element
@@ -336,15 +344,41 @@ def follower_water(mesh, u, h1, h2):
     return f
 
 
+def face_area(mesh, u, col, h, n=64):
+    """The room (m^2 per metre) the face x = const (column col) has moved
+    toward +x below the level h: the integral of u_x over 0 <= Y < h (Gauss-
+    Legendre; small vertical displacements, as the levels' change is small)."""
+    x = 0.0 if col == 0 else mesh.b
+    xg, wg = np.polynomial.legendre.leggauss(n)
+    ys = 0.5 * h * (xg + 1.0)
+    return float(sum(0.5 * h * w * mesh.interp(u, x, y)[0] for y, w in zip(ys, wg)))
+
+
 def plate_solution(dp, weight=True, nonlinear_=False, nx=4, nu=0.0, b=PLATE['b'],
                    L=PLATE['L'], E=PLATE['E'], rho_s=PLATE['rho_s'], h1=None, h2=None,
-                   follower=False):
+                   follower=False, fixed_volume=False):
     """The plate at rest: u_x (m) at the probe (dp/2, L - dp/2) and at the top's
     middle (b/2, L), as a dict {'probe', 'top_mid'}. follower (nonlinear only):
     the water pressure at the current positions, normal to the deformed faces,
-    in place of the dead load."""
+    in place of the dead load. fixed_volume: the basins are closed, so the
+    bent plate lowers the left level by the room it gives that basin over its
+    width and raises the right one likewise (iterated to 1e-9 m); the dict
+    then also holds the levels h1, h2 (m)."""
     h1 = PLATE['h1'] - dp / 2 if h1 is None else h1
     h2 = PLATE['h2'] - dp / 2 if h2 is None else h2
+    if fixed_volume:
+        h10, h20 = h1, h2
+        for _ in range(30):
+            r = plate_solution(dp, weight, nonlinear_, nx, nu, b, L, E, rho_s, h1, h2, follower)
+            mesh = Mesh(nx, 7 * nx, b, L)
+            u = r['u']
+            n1 = h10 - face_area(mesh, u, 0, h1) / BASINS['w1']
+            n2 = h20 + face_area(mesh, u, mesh.cols - 1, h2) / BASINS['w2']
+            done = abs(n1 - h1) < 1e-9 and abs(n2 - h2) < 1e-9
+            h1, h2 = n1, n2
+            if done:
+                return dict(r, h1=h1, h2=h2)
+        raise RuntimeError('plate_fe: the fixed-volume levels did not settle in 30 solves')
     mesh = Mesh(nx, 7 * nx, b, L)
     C = elasticity(E, nu)
     f_lat = water_load(mesh, h1, h2)
@@ -357,7 +391,7 @@ def plate_solution(dp, weight=True, nonlinear_=False, nx=4, nu=0.0, b=PLATE['b']
     else:
         u = linearised(mesh, C, f_lat, f_w)
     return dict(probe=float(mesh.interp(u, dp / 2, L - dp / 2)[0]),
-                top_mid=float(mesh.interp(u, b / 2, L)[0]))
+                top_mid=float(mesh.interp(u, b / 2, L)[0]), u=u)
 
 
 def plate_tip(dp, weight=True, nonlinear=False, nx=4, nu=0.0, b=PLATE['b'], L=PLATE['L'],
@@ -402,14 +436,18 @@ def converged(dp, weight=True, nonlinear=False, meshes=None, key='probe', follow
     return r[key]['value'], r[key]['error']
 
 
-def converged_table(dp, weight=True, nonlinear=False, meshes=None, follower=False):
+def converged_table(dp, weight=True, nonlinear=False, meshes=None, follower=False,
+                    fixed_volume=False):
     """For the probe and the top's middle: the values on each mesh, the
     extrapolated value, its estimated error and the observed order; and the
-    wall time (s)."""
+    wall time (s). fixed_volume: also the levels on the finest mesh."""
     meshes = meshes or default_meshes()
     t0 = time.time()
-    sols = [plate_solution(dp, weight, nonlinear, nx, follower=follower) for nx in meshes]
+    sols = [plate_solution(dp, weight, nonlinear, nx, follower=follower, fixed_volume=fixed_volume)
+            for nx in meshes]
     out = dict(meshes=list(meshes), seconds=time.time() - t0)
+    if fixed_volume:
+        out['levels'] = (sols[-1]['h1'], sols[-1]['h2'])
     for key in ('probe', 'top_mid'):
         vals = [s[key] for s in sols]
         v, p, e = richardson(vals)
@@ -516,19 +554,24 @@ def mode_name(mode, weight):
                         'dead load: what real water does)'}[mode]
 
 
-def table(dps, weight, mode, meshes):
+def table(dps, weight, mode, meshes, fixed_volume=False):
     """One table: per dp, u_x at the probe on each mesh, extrapolated, its
     estimated error and observed order, Euler-Bernoulli beside, u_x at the
     top's middle (extrapolated) and the wall time."""
     nonlin, follower = MODES[mode]
     print(f'weight: {"yes" if weight else "no"}; {mode_name(mode, weight)}; '
-          f'meshes nx = {", ".join(map(str, meshes))} (ny = 7 nx); u_x in mm')
+          f'meshes nx = {", ".join(map(str, meshes))} (ny = 7 nx); u_x in mm'
+          + ('; levels of fixed volumes' if fixed_volume else ''))
     cols = ' '.join(f'{"nx=" + str(n):>9}' for n in meshes)
     print(f'{"dp (mm)":>8} {cols} {"extrap":>9} {"+-":>8} {"order":>5} {"E-B":>9} '
           f'{"FE/E-B":>7} {"top mid":>9} {"time s":>6}')
     for dp in dps:
-        r = converged_table(dp, weight, nonlin, meshes, follower)
+        r = converged_table(dp, weight, nonlin, meshes, follower, fixed_volume)
         pr, eb = r['probe'], euler_bernoulli_tip(dp, weight)
+        if fixed_volume:
+            print(f'{"":8} levels {1e3 * r["levels"][0]:.4f} / {1e3 * r["levels"][1]:.4f} mm '
+                  f'(from {1e3 * (PLATE["h1"] - dp / 2):.4f} / {1e3 * (PLATE["h2"] - dp / 2):.4f}); '
+                  'E-B at the initial levels')
         vals = ' '.join(f'{1e3 * v:9.5f}' for v in pr['values'])
         print(f'{1e3 * dp:8.3f} {vals} {1e3 * pr["value"]:9.5f} {1e3 * pr["error"]:8.1e} '
               f'{pr["order"]:5.2f} {1e3 * eb:9.5f} {pr["value"] / eb:7.4f} '
@@ -552,6 +595,11 @@ def write_json(path, dps, meshes):
                 r = converged_table(dp, weight, nonlin, meshes, follower)['probe']
                 row[f'{mode}{"" if weight else "_no_weight"}'] = [r['value'], r['error']]
             row['euler_bernoulli' + ('' if weight else '_no_weight')] = euler_bernoulli_tip(dp, weight)
+        # the closed basins' levels (--fixed-volume): what the coupled runs,
+        # which hold the water's volume, should approach
+        r = converged_table(dp, True, True, meshes, True, fixed_volume=True)
+        row['follower_fixed_volume'] = [r['probe']['value'], r['probe']['error']]
+        row['fixed_volume_levels'] = list(r['levels'])
         out['dp'][repr(dp)] = row
         print(f'plate_fe: dp {dp} done', file=sys.stderr, flush=True)
     with open(path, 'w') as f:
@@ -570,6 +618,8 @@ def main():
     ap.add_argument('--both', action='store_true',
                     help='with and without weight, linearised, nonlinear and follower')
     ap.add_argument('--dense', action='store_true', help='numpy dense solves (as on CI)')
+    ap.add_argument('--fixed-volume', action='store_true',
+                    help='the levels the closed basins hold as the plate bends')
     ap.add_argument('--validate', action='store_true')
     ap.add_argument('--max-nx', type=int, default=None)
     ap.add_argument('--json', metavar='PATH',
@@ -591,7 +641,7 @@ def main():
     combos = ([(w, m) for m in MODES for w in (True, False)] if a.both
               else [(not a.no_weight, mode)])
     for w, m in combos:
-        table(a.dp, w, m, meshes)
+        table(a.dp, w, m, meshes, a.fixed_volume)
         print()
 
 
