@@ -4,6 +4,7 @@
 usage: bench/pressure_quality.py [--build build] [--before BUILD] [--out DIR]
                                  [--only flicker,hydro,still,impact,shifting,validation]
                                  [--dps 0.008,0.004,0.002] [--img DIR] [--hydro-only TEXT]
+                                 [--set KEY=VALUE ...]
 
 --build   the build to measure (its bin/ holds fluid_solver and coupler);
 --before  a build of an earlier commit to compare with in the flicker and
@@ -12,7 +13,8 @@ usage: bench/pressure_quality.py [--build build] [--before BUILD] [--out DIR]
           /tmp/before/build -DMPS_TESTS=OFF && cmake --build /tmp/before/build`);
 --out     where the runs go (default: a new directory under /tmp);
 --img     where the plots go (default: OUT; docs/img for the doc's);
---hydro-only  run only the hydro variants whose name contains this text.
+--hydro-only  run only the hydro variants whose name contains this text;
+--set KEY=VALUE  given to every run (repeatable): an option against the default.
 Prints markdown tables. Sections:
   flicker     share of the interior fluid (not on the free surface) at P = 0
               in each snapshot, dam break at 4 mm (0.3 s) with output every
@@ -71,12 +73,16 @@ def source_tree(binary):
     return ROOT
 
 
+# --set KEY=VALUE: added to every run (an option measured against the default)
+EXTRA_SETS = []
+
+
 def run(binary, case, out, sets, env=None):
     """Runs a case (fluid_solver or coupler) into out; returns summary.json.
     The case file is the one of the build's own source tree: an older build
     (--before) does not know the keys cases gained since."""
     cmd = [binary, os.path.join(source_tree(binary), case), '--out', out, '--quiet']
-    for kv in sets:
+    for kv in list(sets) + EXTRA_SETS:
         cmd += ['--set', kv]
     e = dict(os.environ)
     e['OMP_NUM_THREADS'] = '2'
@@ -441,12 +447,15 @@ def main():
     ap.add_argument('--out')
     ap.add_argument('--img')
     ap.add_argument('--only', default='flicker,hydro,still,impact,shifting,validation')
+    ap.add_argument('--set', action='append', default=[], metavar='KEY=VALUE',
+                    help='add --set KEY=VALUE to every run (repeatable)')
     ap.add_argument('--hydro-only', default='',
                     help='run only the hydro variants whose name contains this (e.g. quadratic)')
     ap.add_argument('--dps', default='0.008,0.004,0.002')
     ap.add_argument('--reuse', action='store_true',
                     help='impact: take the runs already in OUT (finished or interrupted)')
     a = ap.parse_args()
+    EXTRA_SETS.extend(a.set)
     a.dps = a.dps.split(',')
     a.out = a.out or tempfile.mkdtemp(prefix='pressure_quality_')
     a.img = a.img or a.out
