@@ -71,7 +71,7 @@ struct mps_lattice_consts {
 struct mps_lattice_consts mps_lattice_consts(double l0, double re);
 
 /* The sum of mps_weight_quadratic over the same lattice, the particle
- * itself included: the reference of mps_ops_density_quadratic. */
+ * itself included: the reference of mps_ops_number_density_quadratic. */
 double mps_lattice_n0_quadratic(double l0, double re);
 
 #endif

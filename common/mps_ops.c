@@ -15,9 +15,9 @@
 #define QUERY(in, i) (!(in)->query || (in)->query[i])
 #define PAIR(in, k) (!(in)->pair_use || (in)->pair_use[k])
 
-/* Eq. 8's sum (quadratic = 0), or that of mps_weight_quadratic with the
- * particle itself (quadratic = 1) */
-static void density_sum(const struct mps_ops_in *in, double *n, int *count, int quadratic)
+/* Eq. 8's sum and count, and with nq the sum of mps_weight_quadratic with the
+ * particle itself, in the same pass over the pairs */
+static void density_sums(const struct mps_ops_in *in, double *n, int *count, double *nq)
 {
     const struct mps_nbr_list *nl = in->nl;
     const double re2 = in->re * in->re;
@@ -25,7 +25,7 @@ static void density_sum(const struct mps_ops_in *in, double *n, int *count, int 
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
             continue;
-        double s = quadratic ? 1.0 : 0.0;
+        double s = 0.0, sq = 1.0;
         int c = 0;
         for (size_t k = nl->start[i]; k < nl->start[i + 1]; k++) {
             int j = nl->j[k];
@@ -38,11 +38,15 @@ static void density_sum(const struct mps_ops_in *in, double *n, int *count, int 
             }
             if (r2 < re2) {
                 double r = sqrt(r2);
-                s += quadratic ? mps_weight_quadratic(r, in->re) : mps_weight(r, in->re);
+                s += mps_weight(r, in->re);
+                if (nq)
+                    sq += mps_weight_quadratic(r, in->re);
                 c++;
             }
         }
         n[i] = s;
+        if (nq)
+            nq[i] = sq;
         if (count)
             count[i] = c;
     }
@@ -50,12 +54,13 @@ static void density_sum(const struct mps_ops_in *in, double *n, int *count, int 
 
 void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count)
 {
-    density_sum(in, n, count, 0);
+    density_sums(in, n, count, NULL);
 }
 
-void mps_ops_density_quadratic(const struct mps_ops_in *in, double *n)
+void mps_ops_number_density_quadratic(const struct mps_ops_in *in, double *n, int *count,
+                                      double *nq)
 {
-    density_sum(in, n, NULL, 1);
+    density_sums(in, n, count, nq);
 }
 
 #ifdef OPS_WIDE

@@ -24,9 +24,11 @@ struct mps_ops_in {
 
 /* Eq. 8: n_i = sum_j w(r_ij); count_i = number of j within re (count may be NULL). */
 void mps_ops_number_density(const struct mps_ops_in *in, double *n, int *count);
-/* The sum of mps_weight_quadratic over the neighbours and the particle
- * itself (fluid.density_weight = quadratic), for the same queries. */
-void mps_ops_density_quadratic(const struct mps_ops_in *in, double *n);
+/* mps_ops_number_density, and in the same pass nq_i: the sum of
+ * mps_weight_quadratic over the neighbours and the particle itself
+ * (fluid.density_weight = quadratic). */
+void mps_ops_number_density_quadratic(const struct mps_ops_in *in, double *n, int *count,
+                                      double *nq);
 
 /* Eq. 12 for a vector field: lap_i = 2d/(lambda n0) sum_j (f_j - f_i) w(r_ij). */
 void mps_ops_laplacian_vec(const struct mps_ops_in *in, double n0, double lambda,

@@ -644,9 +644,10 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     const int ghosts = p->wall_bc != FLUID_WALL_PPE;
     const unsigned char *rows = f->unknown;
     struct mps_ops_in nd_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
-    mps_ops_number_density(&nd_in, f->nd, f->ncount);
     if (p->density_quadratic)
-        mps_ops_density_quadratic(&nd_in, f->nq);
+        mps_ops_number_density_quadratic(&nd_in, f->nd, f->ncount, f->nq);
+    else
+        mps_ops_number_density(&nd_in, f->nd, f->ncount);
     const double nlim = p->beta1 * f->n0, clim = p->beta2 * f->count0;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++)

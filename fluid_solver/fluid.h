@@ -65,7 +65,7 @@ struct fluid {
     double *p;
     double *div;           /* divergence of v* (mixed PPE source) */
     double *nd;            /* particle number density n* (re_n) */
-    double *nq;            /* mps_ops_density_quadratic at x* (fluid.density_weight) */
+    double *nq;            /* mps_ops_number_density_quadratic's at x* (fluid.density_weight) */
     int *ncount;           /* neighbours within re_n */
     int *type;             /* enum fluid_ptype */
     int *id;               /* stable id (solid particles: the solid's id) */

@@ -264,8 +264,7 @@ static void test_density_disorder(void)
     for (int pass = 0; pass < 2; pass++) {
         build(&L, pass ? 0.17 : 0.0, 7);
         struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, ren, NULL, NULL, NULL};
-        mps_ops_number_density(&in, nd, NULL);
-        mps_ops_density_quadratic(&in, nq);
+        mps_ops_number_density_quadratic(&in, nd, NULL, nq);
         double sn = 0.0, sq = 0.0, eq = 0.0;
         int m = 0;
         for (int k = 0; k < N; k++)
