@@ -367,10 +367,9 @@ def plate_solution(dp, weight=True, nonlinear_=False, nx=4, nu=0.0, b=PLATE['b']
     h1 = PLATE['h1'] - dp / 2 if h1 is None else h1
     h2 = PLATE['h2'] - dp / 2 if h2 is None else h2
     if fixed_volume:
-        h10, h20 = h1, h2
+        h10, h20, mesh = h1, h2, Mesh(nx, 7 * nx, b, L)
         for _ in range(30):
             r = plate_solution(dp, weight, nonlinear_, nx, nu, b, L, E, rho_s, h1, h2, follower)
-            mesh = Mesh(nx, 7 * nx, b, L)
             u = r['u']
             n1 = h10 - face_area(mesh, u, 0, h1) / BASINS['w1']
             n2 = h20 + face_area(mesh, u, mesh.cols - 1, h2) / BASINS['w2']

@@ -4,6 +4,7 @@ conservation in still water (docs/pressure.md, "Still water"; docs/hard_cases.md
 "The drift, measured again").
 
 usage: bench/water_volume.py RUN [--x0 X0 --x1 X1] [--dp DP] [--jitter]
+       bench/water_volume.py --survey
 
 For each fluid snapshot of RUN: the mean height of the fluid particles and the
 mean height of the top sqrt(N) of them (the free surface's centres), between
@@ -19,7 +20,12 @@ random by 0.02-0.15 dp, at the same area, against the perfect lattice's (re =
 2.1 dp, the MPS weight re/r - 1): the weight is convex in r, so disorder
 raises the number density, and a correction that holds it at n0 then expands
 the water by about as much; beside it, the quadratic weight of
-fluid.density_weight = quadratic, which disorder raises about a third as much."""
+fluid.density_weight = quadratic, which disorder raises about a third as much.
+--survey (no RUN): the weights considered for fluid.density_weight, each
+with its support: the rise of the sum on the lattice jittered by 0.1 dp, and
+its deficit in the rows at and under a free surface (row 0 the surface
+particles, row 1 the first row the PPE solves), as docs/pressure.md quotes
+them."""
 import argparse
 import glob
 import os
@@ -89,14 +95,67 @@ def jitter_table(re=2.1, n=40, seed=1):
             for s in (0.02, 0.05, 0.1, 0.15)]
 
 
+# the candidates of --survey: q = r / re; 'self' adds w(0) (the particle itself)
+SURVEY = [('Eq. 7 (re/r - 1)', lambda q: 1 / q - 1, 2.1, False),
+          ('quadratic (1 - q)^2', lambda q: (1 - q) ** 2, 2.1, True),
+          ('Wendland C2', lambda q: (1 - q) ** 4 * (1 + 4 * q), 2.1, True),
+          ('Wendland C2', lambda q: (1 - q) ** 4 * (1 + 4 * q), 4.0, True),
+          ('cubic spline', lambda q: np.where(q < 0.5, 1 - 6 * q ** 2 + 6 * q ** 3, 2 * (1 - q) ** 3), 3.0, True)]
+
+
+def lattice_sum(w, re, x, n, self_):
+    """Mean over x (periodic box n) of the sum of w(r/re) over the others
+    within re, plus w(0) if self_."""
+    tot = 0.0
+    for c in range(0, len(x), 400):
+        d = x[c:c + 400, None, :] - x[None, :, :]
+        d -= n * np.round(d / n)
+        r = np.hypot(d[..., 0], d[..., 1])
+        m = (r > 0) & (r < re)
+        tot += np.sum(w(r[m] / re))
+    return tot / len(x) + (float(w(np.array(0.0))) if self_ else 0.0)
+
+
+def surface_deficit(w, re, self_, rows=3):
+    """The sum at rows 0, 1, ... under a flat free surface (the lattice y <= 0)
+    against the full lattice's."""
+    k = int(re) + 2
+    a, b = np.meshgrid(np.arange(-k, k + 1), np.arange(-k, k + 1))
+
+    def total(keep):
+        r = np.hypot(a, b)[keep]
+        m = (r > 0) & (r < re)
+        return np.sum(w(r[m] / re)) + (float(w(np.array(0.0))) if self_ else 0.0)
+    full = total(np.ones_like(a, bool))
+    return [total(b <= row) / full - 1 for row in range(rows)]
+
+
+def survey(n=40, seed=1, sigma=0.1):
+    g = np.stack(np.meshgrid(np.arange(n), np.arange(n)), -1).reshape(-1, 2).astype(float)
+    jit = (g + sigma * np.random.default_rng(seed).standard_normal(g.shape)) % n
+    print(f'weight, support (dp): rise on a lattice jittered by {sigma} dp; deficit at rows 0, 1, 2 '
+          'under a free surface')
+    with np.errstate(divide='ignore'):
+        for name, w, re, self_ in SURVEY:
+            rise = lattice_sum(w, re, jit, n, self_) / lattice_sum(w, re, g, n, self_) - 1
+            d = surface_deficit(w, re, self_)
+            print(f'{name}, {re}: {100 * rise:+.2f}%; ' + ', '.join(f'{100 * v:+.1f}%' for v in d))
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument('run')
+    ap.add_argument('run', nargs='?')
+    ap.add_argument('--survey', action='store_true')
     ap.add_argument('--x0', type=float)
     ap.add_argument('--x1', type=float)
     ap.add_argument('--dp', type=float)
     ap.add_argument('--jitter', action='store_true')
     a = ap.parse_args()
+    if a.survey:
+        survey()
+        return
+    if not a.run:
+        ap.error('RUN is needed (or --survey)')
     if a.jitter:
         for sig, ratio, quad in jitter_table():
             print(f'square lattice jittered by {sig:.2f} dp: number density {100 * (ratio - 1):+.2f}% '
