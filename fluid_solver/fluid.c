@@ -449,14 +449,20 @@ static void shift(struct fluid *f, double dt)
  * candidate with a neighbour near T has no empty side: it sits at a small gap
  * (next to a wall, or inside the water after particles rearranged) and keeps
  * its PPE row. Without the scan such gaps get P = 0, which pulls the water
- * apart further. */
+ * apart further. fluid.surface_scan_density: candidates sparser than that
+ * share of n0 are not scanned; in the spray after an impact a particle at
+ * 0.5-0.7 n0 nearly always has some neighbour near T, so the scan kept it in
+ * the PPE, where it came out under tension and was clamped: 18% of the
+ * 6 mm plate's interior at P = 0, the plate's load flickering with it
+ * (docs/pressure.md, "Spray and tension"). */
 static void surface_scan(struct fluid *f)
 {
     const double re = f->prm.re_n * f->prm.dp, re2 = re * re;
     const double rs = f->prm.surface_scan * f->prm.dp, rs2 = rs * rs;
+    const double nmin = f->prm.surface_scan_density * f->n0;
 #pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < f->nfluid; i++) {
-        if (!f->surface[i])
+        if (!f->surface[i] || f->nd[i] < nmin)
             continue;
         double m[MPS_DIM] = {0};
         for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
@@ -729,6 +735,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     f->time += dt;
     f->step++;
     f->dt_last = dt;
+    f->dt_kappa = f->last.dt_kappa;
     guard_tank(f);
     st = remove_lost(f, err);
     if (!st)

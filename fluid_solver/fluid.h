@@ -43,6 +43,7 @@ enum fluid_phase {
 struct fluid_step_stats {
     double dt;
     double dt_cfl;         /* the CFL step at the step's start (>= dt) */
+    double dt_kappa;       /* the step Eq. 23's correction was scaled by (fluid_ppe.c) */
     int ppe_iterations;
     int ppe_rows;
     int rows_at_zero;      /* PPE rows whose pressure came out <= 0 (clamped) */
@@ -121,6 +122,7 @@ struct fluid {
     double time;
     long step;
     double dt_last;
+    double dt_kappa;           /* the last step's dt_kappa (fluid.kappa_step_decay) */
     long ppe_iterations;
     long nbr_rebuilds;
     long lost;             /* fluid particles that splashed out of an open tank */

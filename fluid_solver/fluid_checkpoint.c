@@ -6,13 +6,14 @@
 /* The scalars, as one block (the order is the format). */
 struct fluid_scalars {
     uint64_t nfluid, nfixed_end;
-    double time, dt_last, load_scale;
+    double time, dt_last, dt_kappa, load_scale;
     int64_t step, lost, wall_guard, solid_placed;
 };
 
 enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
-    struct fluid_scalars sc = {f->nfluid, f->nfixed_end, f->time, f->dt_last, f->load_scale,
+    struct fluid_scalars sc = {f->nfluid, f->nfixed_end, f->time, f->dt_last, f->dt_kappa,
+                               f->load_scale,
                                f->step, f->lost, f->wall_guard, f->solid_placed};
     struct fluid_sensors_mark m;
     memset(&m, 0, sizeof m); /* padding: the image's bytes depend only on the state */
@@ -39,6 +40,7 @@ enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_
     f->nfixed_end = (size_t)sc.nfixed_end;
     f->time = sc.time;
     f->dt_last = sc.dt_last;
+    f->dt_kappa = sc.dt_kappa;
     f->load_scale = sc.load_scale;
     f->step = (long)sc.step;
     f->lost = (long)sc.lost;

@@ -30,6 +30,12 @@ const struct mps_key_spec fluid_case_keys[] = {
      "does); a longer step corrects kappa, as printed. 0 (default): always as printed; "
      "5e-4 halves the dam break's flicker but the 3 mm plate's water expands over the walls "
      "(docs/pressure.md)"},
+    {"fluid.kappa_step_decay", MPS_KEY_DOUBLE, "0", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
+     "the step that scales Eq. 23's correction (kappa rho / (dt dtk)) falls by at most this "
+     "factor per step: after the CFL step drops at an impact the correction strengthens "
+     "over several steps instead of quadrupling its pressure at once (dtk = max(dt, "
+     "decay x the previous step's dtk)); 0 (default): dtk = dt, as printed; 0.95: about "
+     "14 steps to follow a halved step (docs/pressure.md)"},
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
@@ -53,6 +59,10 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.surface_scan", MPS_KEY_DOUBLE, "1.15", 0, 1.4, 0, NULL, "dp",
      "a free-surface candidate stays one only if no neighbour lies within this distance "
      "of the point dp outside it (0: the paper's double check alone)"},
+    {"fluid.surface_scan_density", MPS_KEY_DOUBLE, "0", 0, 1, 0, NULL, "n0",
+     "the scan confirms only candidates whose number density is at least this fraction of "
+     "n0; sparser ones (spray, aerated water) stay on the free surface at P = 0 as the "
+     "paper's double check says. 0 (default): every candidate is scanned (docs/pressure.md)"},
     {"fluid.gradient", MPS_KEY_ENUM, "corrected", 0, 0, 0, "corrected|plain", "",
      "pressure gradient: Eq. 14-15 (corrected) or Eq. 9 (plain)"},
     {"fluid.wall_bc", MPS_KEY_ENUM, "solid_ppe", 0, 0, 0, "solid_ppe|neumann|ppe", "",
@@ -261,6 +271,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->dt_min = mps_case_double(c, "fluid.dt_min");
     p->kappa = mps_case_double(c, "fluid.kappa");
     p->kappa_dt = mps_case_double(c, "fluid.kappa_dt");
+    p->kappa_step_decay = mps_case_double(c, "fluid.kappa_step_decay");
     p->density_quadratic = strcmp(mps_case_string(c, "fluid.density_weight"), "quadratic") == 0;
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
@@ -271,6 +282,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->beta1 = mps_case_double(c, "fluid.beta1");
     p->beta2 = mps_case_double(c, "fluid.beta2");
     p->surface_scan = mps_case_double(c, "fluid.surface_scan");
+    p->surface_scan_density = mps_case_double(c, "fluid.surface_scan_density");
     p->gradient = strcmp(mps_case_string(c, "fluid.gradient"), "plain") == 0
                       ? FLUID_GRAD_PLAIN
                       : FLUID_GRAD_CORRECTED;

@@ -65,10 +65,12 @@ struct fluid_params {
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
     double kappa_dt;              /* s: steps shorter than this correct kappa dt / kappa_dt */
+    double kappa_step_decay;      /* per step: how fast Eq. 23's reference step may fall */
     int density_quadratic;        /* Eq. 23's density error from mps_weight_quadratic */
     double re_n, re_lap;          /* effective radii, multiples of dp */
     double beta1, beta2;          /* free-surface double check */
     double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */
+    double surface_scan_density;  /* scan only candidates with n >= this x n0 */
     enum fluid_gradient gradient;
     enum fluid_wall_bc wall_bc;
     enum fluid_solid_load solid_load;

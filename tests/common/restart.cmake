@@ -41,6 +41,19 @@ add_test(NAME restart_coupled_plate_kill
           cases/dambreak_elastic_plate/case.yml --set dp=0.006 --set end_time=0.2
           --set output.interval=0.05 --set output.checkpoint_interval=0.05
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# the same with the pressure options of docs/pressure.md ("Spray and
+# tension"): fluid.kappa_step_decay carries the last step's reference step
+# from one step to the next, so the checkpoint must hold it. Restarted from
+# the checkpoint at 0.1303 s, in the steps after the impact (0.128 s) where
+# the CFL step drops and the decay is acting: a restart that forgot it fails
+# here (probes differ from row 66), at 0.1 s it would not be seen. Ends at
+# 0.19 s so that the checkpoint restarted from is still among the last two.
+add_test(NAME restart_coupled_plate_pressure_options
+  COMMAND ${RS_CHECK} ${RS_OUT}/plate_popt 0.131 0.16 $<TARGET_FILE:coupler>
+          cases/dambreak_elastic_plate/case.yml --set dp=0.006 --set end_time=0.19
+          --set output.interval=0.05 --set output.checkpoint_interval=0.0325
+          --set fluid.kappa_step_decay=0.95 --set fluid.surface_scan_density=0.9
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # coupled with the TLSPH solid: the elastic gate at 2.5 mm to 0.08 s
 add_test(NAME restart_coupled_gate_tlsph
   COMMAND ${RS_CHECK} ${RS_OUT}/gate 0.04 0.06 $<TARGET_FILE:coupler>
@@ -49,7 +62,7 @@ add_test(NAME restart_coupled_gate_tlsph
           --solid "solid_solver --model tlsph"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(restart_coupled_plate restart_coupled_plate_kill restart_coupled_gate_tlsph
-  PROPERTIES TIMEOUT 120 LABELS integration)
+  restart_coupled_plate_pressure_options PROPERTIES TIMEOUT 120 LABELS integration)
 # coupled with the Python modal solid (its own checkpoint format): the plate in
 # water of the coupler tests to 0.2 s, restarted at 0.1 s
 add_test(NAME restart_coupled_python_solid
