@@ -59,10 +59,10 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.surface_scan", MPS_KEY_DOUBLE, "1.15", 0, 1.4, 0, NULL, "dp",
      "a free-surface candidate stays one only if no neighbour lies within this distance "
      "of the point dp outside it (0: the paper's double check alone)"},
-    {"fluid.surface_scan_density", MPS_KEY_DOUBLE, "0", 0, 1, 0, NULL, "n0",
-     "the scan confirms only candidates whose number density is at least this fraction of "
-     "n0; sparser ones (spray, aerated water) stay on the free surface at P = 0 as the "
-     "paper's double check says. 0 (default): every candidate is scanned (docs/pressure.md)"},
+    {"fluid.surface_scan_density", MPS_KEY_DOUBLE, "0.9", 0, 1, 0, NULL, "n0",
+     "candidates sparser than this fraction of n0 with no wall or solid particle within re_n "
+     "(spray, aerated water) skip the scan and stay on the free surface at P = 0, as the "
+     "paper's double check says; 0: every candidate is scanned (docs/pressure.md)"},
     {"fluid.gradient", MPS_KEY_ENUM, "corrected", 0, 0, 0, "corrected|plain", "",
      "pressure gradient: Eq. 14-15 (corrected) or Eq. 9 (plain)"},
     {"fluid.wall_bc", MPS_KEY_ENUM, "solid_ppe", 0, 0, 0, "solid_ppe|neumann|ppe", "",

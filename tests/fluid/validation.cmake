@@ -34,23 +34,30 @@ add_test(NAME fluid_valid_hydrostatic
 # (0.1-0.2 points of every error below), so the margins are what a change
 # of the numerics may move (about a point), not noise. Measured on
 # 2026-12-02 (this build; docs/fluid.md has the resolution study):
-#  - front speed dZ/dT for T >= 1.4 within 1.5% of the measured 1.298: after
-#    the release the front moves at the measured speed (-0.5% here; -0.9%,
-#    +2.8%, +0.9% at 8, 4, 2 mm in the study);
+#  - front speed dZ/dT for T >= 1.4 within 3% of the measured 1.298: after
+#    the release the front moves at the measured speed (-0.9%, +2.8%, +0.9%
+#    at 8, 4, 2 mm in the study). Its slope is set by the front's sparse tip
+#    particles, and how they are classified moves it by points: with the
+#    spray left on the free surface (fluid.surface_scan_density 0.9, the
+#    default since 2026-12-03) +2.2% (one thread) and +2.1% (two), -0.5%
+#    before; at 4 mm +2.9% against +8.0% before (one thread). The band was
+#    1.5% on the earlier build's -0.5% alone; 3% holds the measured spread
+#    of these numerics changes and still catches Eq. 17's position 10% short
+#    (-9.2%). The other measures below improved with that change;
 #  - front against the measurements 17 ms later (--shift 0.2: the release
 #    time of the experiment's diaphragm, docs/fluid.md): max 10% (measured
-#    8.9%), mean 3.5% (2.8%);
-#  - front as measured: max 21% (19.4%), mean 13.5% (12.0%): the lead gained
-#    in the release, which does not shrink with resolution;
-#  - height at the left wall: max 11% (9.6%), mean 4.5% (3.4%): it converges
-#    with dp (11, 7, 4% at 8, 4, 2 mm).
+#    8.9%; 8.9% since the spray change), mean 3.5% (2.8%; 2.3%);
+#  - front as measured: max 21% (19.4%; 18.0%), mean 13.5% (12.0%; 11.5%):
+#    the lead gained in the release, which does not shrink with resolution;
+#  - height at the left wall: max 11% (9.6%; 9.1%), mean 4.5% (3.4%; 2.7%):
+#    it converges with dp (11, 7, 4% at 8, 4, 2 mm).
 # What they catch (measured with the fault in place): the pressure gradient
 # of Eq. 19 10% weak moves the height to 14.0% / 5.5% and the shifted front
 # mean to 4.5%; Eq. 17's position 10% short moves the speed to -9.2%. The old
 # bands (25/15% front, 10% speed, 18/10% height) passed both.
 add_test(NAME fluid_valid_dambreak
   COMMAND ${FV_RUN} ${FV_OUT}/dambreak ${FV_DIR}/check_dambreak.py
-          --max-front-err 0.21 --mean-front-err 0.135 --speed-err 0.015
+          --max-front-err 0.21 --mean-front-err 0.135 --speed-err 0.03
           --max-height-err 0.11 --mean-height-err 0.045
           --shift 0.2 --shifted-max-err 0.10 --shifted-mean-err 0.035
           -- ${FV_SOLVER} cases/dambreak/case.yml --set dp=0.008 --set end_time=0.27
