@@ -49,6 +49,8 @@ import plate_compare as pc  # noqa: E402
 
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'fluid'))
 import check_flicker  # noqa: E402
+sys.path.insert(0, os.path.join(ROOT, 'tests', 'coupler'))
+from check_plate_flicker import force_smoothness  # noqa: E402  (one definition, the ctest's)
 
 RHO, G = 1000.0, 9.81
 
@@ -123,25 +125,6 @@ def probes_like(path):
         rows = list(csv.reader(l for l in f if not l.startswith('#')))
     data = np.array([[float(x) for x in r] for r in rows[1:]])
     return {h: data[:, k] for k, h in enumerate(rows[0])}
-
-
-def force_smoothness(run_dir):
-    """The plate force rows (mean over each 2 ms probe interval) against
-    their centred 20 ms running mean, after the first impact (|F| above 10%
-    of its peak): share of rows within 15% of the mean (the mean floored at
-    10% of the peak, where the force passes through zero), the RMS of the
-    deviation and the mean change from row to row."""
-    p = probes(run_dir)
-    t, fx = p['time'], p['solid_fx']
-    peak = np.abs(fx).max()
-    t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
-    w = max(1, int(round(0.02 / np.median(np.diff(t)))))
-    mean = np.convolve(fx, np.ones(w) / w, mode='same')
-    m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
-    dev = np.abs(fx - mean)[m]
-    ref = np.maximum(np.abs(mean[m]), 0.1 * peak)
-    return {'first_impact_s': float(t0), 'peak': float(peak), 'within15': float(np.mean(dev <= 0.15 * ref)),
-            'rms_dev': float(np.sqrt(np.mean(dev ** 2))), 'step_change': float(np.mean(np.abs(np.diff(fx[m]))))}
 
 
 def fmt_shares(s):
