@@ -93,10 +93,12 @@ FAULTS = [
       new='            f->x[i][d] += 0.9 * dt * f->vstar[i][d];',
       what='the predicted position moves 10% short of v*',
       hint='fluid_valid_dambreak|test_fluid_step'),
-    F(id='spray_threshold_low', eq='section 4.3 (fluid.surface_scan_density)', file='fluid_solver/fluid.c',
+    # (a 10% lower threshold, 0.81 n0, survives the whole fast suite: the
+    # spray sits at 0.50-0.62 n0, far below both cuts; docs/testing.md)
+    F(id='spray_threshold_off', eq='section 4.3 (fluid.surface_scan_density)', file='fluid_solver/fluid.c',
       old='if (!f->surface[i] || (f->nd[i] < nmin && !boundary_within(f, i, re2)))',
-      new='if (!f->surface[i] || (f->nd[i] < 0.9 * nmin && !boundary_within(f, i, re2)))',
-      what='the spray left on the free surface only below 0.81 n0 instead of 0.9 n0 (a 10% error in the threshold)',
+      new='if (!f->surface[i] || (f->nd[i] < 0.0 * nmin && !boundary_within(f, i, re2)))',
+      what='every candidate scanned again: the spray taken back into the PPE under tension',
       hint='coupled_plate_flicker_scan'),
     F(id='spray_walls_not_exempt', eq='section 4.3 (fluid.surface_scan_density)', file='fluid_solver/fluid.c',
       old='        if (!f->is_fluid[j] && mps_pair_delta((const double(*)[MPS_DIM])f->x, i, (size_t)j, dx) < re2)',
