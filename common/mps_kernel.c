@@ -9,19 +9,22 @@
 
 struct mps_lattice_consts mps_lattice_consts(double l0, double re)
 {
-    struct mps_lattice_consts c = {0.0, 0.0, 0};
+    struct mps_lattice_consts c = {0.0, 0.0, 0.0, 0};
     int k = (int)ceil(re / l0) + 1;
-    double sum_w = 0.0, sum_r2w = 0.0;
+    double sum_w = 0.0, sum_r2w = 0.0, sum_q = 0.0;
 #if MPS_DIM == 2
     for (int a = -k; a <= k; a++)
         for (int b = -k; b <= k; b++) {
-            if (a == 0 && b == 0)
+            if (a == 0 && b == 0) {
+                sum_q += mps_weight_quadratic(0.0, re); /* the particle itself */
                 continue;
+            }
             double r = l0 * sqrt((double)(a * a + b * b));
             if (r < re) {
                 double w = mps_weight(r, re);
                 sum_w += w;
                 sum_r2w += r * r * w;
+                sum_q += mps_weight_quadratic(r, re);
                 c.count++;
             }
         }
@@ -30,21 +33,8 @@ struct mps_lattice_consts mps_lattice_consts(double l0, double re)
 #endif
     c.n0 = sum_w;
     c.lambda = sum_w > 0.0 ? sum_r2w / sum_w : 0.0;
+    c.nq0 = sum_q;
     return c;
-}
-
-double mps_lattice_n0_quadratic(double l0, double re)
-{
-    int k = (int)ceil(re / l0) + 1;
-    double sum_w = 0.0;
-#if MPS_DIM == 2
-    for (int a = -k; a <= k; a++)
-        for (int b = -k; b <= k; b++)
-            sum_w += mps_weight_quadratic(l0 * sqrt((double)(a * a + b * b)), re);
-#else
-#error "mps_lattice_n0_quadratic: only MPS_DIM == 2 is implemented"
-#endif
-    return sum_w;
 }
 
 void mps_weights_r2_sse2(double *restrict w, size_t n, double re, double scale)

@@ -63,15 +63,13 @@ static inline double mps_weight_quadratic(double r, double re)
 struct mps_lattice_consts {
     double n0;       /* Eq. 8 on the full square lattice */
     double lambda;   /* Eq. 13, m^2 */
+    double nq0;      /* the sum of mps_weight_quadratic, the particle itself included:
+                      * the reference of mps_ops_number_density_quadratic */
     int count;       /* neighbours inside re (N0 of the free-surface check) */
 };
 
 /* Constants for a particle inside a full square lattice of spacing l0, with
  * effective radius re (both in m). */
 struct mps_lattice_consts mps_lattice_consts(double l0, double re);
-
-/* The sum of mps_weight_quadratic over the same lattice, the particle
- * itself included: the reference of mps_ops_number_density_quadratic. */
-double mps_lattice_n0_quadratic(double l0, double re);
 
 #endif

@@ -163,7 +163,7 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     f->n0 = cn.n0;
     f->count0 = cn.count;
     f->n0_lap = cl.n0;
-    f->nq0 = mps_lattice_n0_quadratic(prm->dp, prm->re_n * prm->dp);
+    f->nq0 = cn.nq0;
     f->lambda_lap = cl.lambda;
     f->skin = SKIN_FRACTION * prm->dp;
 

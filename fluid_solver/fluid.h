@@ -89,7 +89,7 @@ struct fluid {
     size_t nfluid, nfixed_end;
     /* lattice constants */
     double n0, n0_lap, lambda_lap;
-    double nq0;            /* mps_lattice_n0_quadratic at re_n (fluid.density_weight) */
+    double nq0;            /* mps_lattice_consts' nq0 at re_n (fluid.density_weight) */
     double load_scale;     /* Eq. 50 normalisation, see fluid_coupling.c */
     int solid_placed;      /* walls under the solid removed */
     int count0;

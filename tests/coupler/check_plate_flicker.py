@@ -19,19 +19,15 @@ with every candidate scanned (0, the code before) 17.6-18.2% and 47%. 0.08
 and 0.65 sit between, with room for the run's chaotic detail (a thread count
 or a build moves them by a few points).
 Exit 0 if both hold, 1 otherwise."""
-import argparse, csv, os, sys
+import argparse, os, sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', 'fluid'))
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, '..', 'fluid'))
+sys.path.insert(0, os.path.join(HERE, '..', '..', 'bench'))
 import check_flicker  # noqa: E402
-
-
-def probes(run_dir):
-    with open(os.path.join(run_dir, 'probes.csv')) as f:
-        rows = list(csv.reader(l for l in f if not l.startswith('#')))
-    data = np.array([[float(x) for x in r] for r in rows[1:]])
-    return {h: data[:, k] for k, h in enumerate(rows[0])}
+from probes_csv import probes_table  # noqa: E402
 
 
 def force_smoothness(run_dir, column='solid_fx'):
@@ -40,7 +36,7 @@ def force_smoothness(run_dir, column='solid_fx'):
     of its peak): share of rows within 15% of the mean (the mean floored at
     10% of the peak, where the force passes through zero), the RMS of the
     deviation and the mean change from row to row."""
-    p = probes(run_dir)
+    p = probes_table(os.path.join(run_dir, 'probes.csv'))
     t, fx = p['time'], p[column]
     peak = np.abs(fx).max()
     t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]

@@ -10,16 +10,12 @@ rows_at_zero / ppe_rows. --max-zero-share: the largest share after --after s
 may not exceed S. --max-steps-over: at most COUNT steps after --after s may
 have a share above SHARE. The bands are set where the tests call this
 (tests/coupler/plate.cmake), each with what it measured. Exit 0 if all hold, 1 otherwise."""
-import argparse, csv, os, sys
+import argparse, os, sys
 
 import numpy as np
 
-
-def step_log(run):
-    with open(os.path.join(run, 'fluid_steps.csv')) as f:
-        rows = list(csv.reader(l for l in f if not l.startswith('#')))
-    data = np.array([[float(x) for x in r] for r in rows[1:]])
-    return {h: data[:, k] for k, h in enumerate(rows[0])}
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
+from probes_csv import probes_table  # noqa: E402
 
 
 def main():
@@ -29,7 +25,7 @@ def main():
     ap.add_argument('--max-zero-share', type=float)
     ap.add_argument('--max-steps-over', type=float, nargs=2, metavar=('SHARE', 'COUNT'))
     a = ap.parse_args()
-    s = step_log(a.run)
+    s = probes_table(os.path.join(a.run, 'fluid_steps.csv'))
     keep = s['time'] > a.after
     if not keep.any():
         print('FAIL: no step after t = %g s in %s' % (a.after, a.run))

@@ -237,12 +237,6 @@ static void test_perturbed(double jitter)
     release(&L);
 }
 
-/* mps_ops_laplacian_vec against mps_ops_laplacian of each component (x^2 +
- * y^2 and a linear field), with a use mask (every third particle left out)
- * and a query mask (every other one), on a perturbed lattice, on both paths
- * (where the CPU has AVX-512): the same sums, in another order and with the
- * weights' last bits on the AVX-512 path, so within 1e-12 of the largest
- * value. */
 /* The mean over the interior of n / n_ref - 1 for both weights, on a lattice
  * jittered by up to `jitter` dp (uniform in each direction). Eq. 7's weight
  * is convex in r, so disorder raises Eq. 8's mean; the quadratic weight,
@@ -257,7 +251,7 @@ static void test_density_disorder(void)
     static struct lattice L;
     const double ren = 2.1 * DP;
     struct mps_lattice_consts cn = mps_lattice_consts(DP, ren);
-    const double nq0 = mps_lattice_n0_quadratic(DP, ren);
+    const double nq0 = cn.nq0;
     CHECK(nq0 > 1.0); /* the particle itself and its neighbours */
     static double nd[N], nq[N];
     double rise[2] = {0.0, 0.0};
@@ -288,6 +282,12 @@ static void test_density_disorder(void)
     CHECK(fabs(rise[1]) < rise[0] / 2.0);
 }
 
+/* mps_ops_laplacian_vec against mps_ops_laplacian of each component (x^2 +
+ * y^2 and a linear field), with a use mask (every third particle left out)
+ * and a query mask (every other one), on a perturbed lattice, on both paths
+ * (where the CPU has AVX-512): the same sums, in another order and with the
+ * weights' last bits on the AVX-512 path, so within 1e-12 of the largest
+ * value. */
 static void test_laplacian_vec(void)
 {
     static struct lattice L;
