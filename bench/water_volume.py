@@ -80,19 +80,13 @@ def jitter_table(re=2.1, n=40, seed=1):
     ((1 - r/re)^2, the particle itself included)."""
     rng = np.random.default_rng(seed)
     g = np.stack(np.meshgrid(np.arange(n), np.arange(n)), -1).reshape(-1, 2).astype(float)
-
-    def mean_n(x):
-        tot = np.zeros(2)
-        for c in range(0, len(x), 400):
-            d = x[c:c + 400, None, :] - x[None, :, :]
-            d -= n * np.round(d / n)
-            r = np.hypot(d[..., 0], d[..., 1])
-            m = (r > 0) & (r < re)
-            tot += [np.sum(re / r[m] - 1), np.sum((1 - r[m] / re) ** 2)]
-        return tot / len(x) + [0.0, 1.0]
-    n0 = mean_n(g)
-    return [(s, *(mean_n((g + s * rng.standard_normal(g.shape)) % n) / n0))
-            for s in (0.02, 0.05, 0.1, 0.15)]
+    weights = [(lambda q: 1 / q - 1, False), (lambda q: (1 - q) ** 2, True)]
+    n0 = [lattice_sum(w, re, g, n, self_) for w, self_ in weights]
+    out = []
+    for s in (0.02, 0.05, 0.1, 0.15):
+        x = (g + s * rng.standard_normal(g.shape)) % n
+        out.append((s, *(lattice_sum(w, re, x, n, self_) / m for (w, self_), m in zip(weights, n0))))
+    return out
 
 
 # the candidates of --survey: q = r / re; 'self' adds w(0) (the particle itself)
