@@ -14,7 +14,7 @@ deflection) and its period from the zero crossings of tip_dx - mean. L is the
 free length the lattice gives at each dp (the rows above y = 0).
 
 usage: bench/sloshing_plate_alone.py [--dp 0.002 0.001 0.0008] [--out DIR]
-       [--plot docs/img/sloshing_plate_alone.png] > table.md
+       [--plot docs/img/sloshing_plate_alone.png] [--set KEY=VALUE ...] > table.md
 """
 import argparse
 import math
@@ -66,6 +66,8 @@ def main():
     ap.add_argument('--out', default='runs/plate_alone')
     ap.add_argument('--courant', default='0.75')
     ap.add_argument('--plot', default=None)
+    ap.add_argument('--set', action='append', default=[], metavar='KEY=VALUE',
+                    help='passed to the solid (e.g. solid.refine=2), after the script\'s own')
     a = ap.parse_args()
     rows = []
     for case, H in CASES.items():
@@ -87,6 +89,8 @@ def main():
                            '--set', 'output.probe_interval=0.0002', '--set', 'motion.kind=none',
                            '--set', f'gravity.x={-A}', '--set', 'gravity.y=0',
                            '--set', f'solid.plane={plane}', '--set', f'solid.courant={a.courant}']
+                    for kv in a.set:
+                        cmd += ['--set', kv]
                     r = subprocess.run(cmd, capture_output=True, text=True)
                     if r.returncode:
                         rows.append((case, plane, dp, model, L, w0, f0, None, None, r.stderr.strip()))
