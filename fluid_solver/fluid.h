@@ -127,6 +127,9 @@ struct fluid {
     long nbr_rebuilds;
     long lost;             /* fluid particles that splashed out of an open tank */
     long wall_guard;       /* times a particle was put back inside the tank */
+    long wall_guard_face[4];   /* of them through the floor, left, right wall, lid */
+    double wall_guard_first[3]; /* the first use (if wall_guard > 0): time, x, y */
+    int wall_guard_first_face;  /* and its face, as wall_guard_face's index */
     struct fluid_step_stats last;
     struct mps_timer timer;
     struct fluid_sensors *sens;   /* time means of the averaged probes (NULL: none) */

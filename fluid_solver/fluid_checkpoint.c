@@ -10,18 +10,30 @@ struct fluid_scalars {
     int64_t step, lost, wall_guard, solid_placed;
 };
 
+/* The tank guard's log (fluid_summary.json), a block of its own. */
+struct fluid_guard_log {
+    int64_t face[4], first_face;
+    double first[3];
+};
+
 enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     struct fluid_scalars sc = {f->nfluid, f->nfixed_end, f->time, f->dt_last, f->dt_kappa,
                                f->load_scale,
                                f->step, f->lost, f->wall_guard, f->solid_placed};
+    struct fluid_guard_log g = {{f->wall_guard_face[0], f->wall_guard_face[1],
+                                 f->wall_guard_face[2], f->wall_guard_face[3]},
+                                f->wall_guard_first_face,
+                                {f->wall_guard_first[0], f->wall_guard_first[1],
+                                 f->wall_guard_first[2]}};
     struct fluid_sensors_mark m;
     memset(&m, 0, sizeof m); /* padding: the image's bytes depend only on the state */
     fluid_sensors_keep(f, &m);
     enum mps_status st;
     if ((st = mps_particles_put(&f->ps, c, err)) || (st = mps_nbr_list_put(&f->nl, "nl", c, err)) ||
         (st = mps_nbr_list_put(&f->nl_tank, "nl_tank", c, err)) ||
-        (st = mps_ckpt_put(c, "fluid", &sc, sizeof sc, err)))
+        (st = mps_ckpt_put(c, "fluid", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_put(c, "guard", &g, sizeof g, err)))
         return st;
     return mps_ckpt_put(c, "sensors", &m, sizeof m, err);
 }
@@ -29,11 +41,13 @@ enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struc
 enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     struct fluid_scalars sc;
+    struct fluid_guard_log g;
     struct fluid_sensors_mark m;
     enum mps_status st;
     if ((st = mps_particles_get(&f->ps, c, err)) || (st = mps_nbr_list_get(&f->nl, "nl", c, err)) ||
         (st = mps_nbr_list_get(&f->nl_tank, "nl_tank", c, err)) ||
         (st = mps_ckpt_get(c, "fluid", &sc, sizeof sc, err)) ||
+        (st = mps_ckpt_get(c, "guard", &g, sizeof g, err)) ||
         (st = mps_ckpt_get(c, "sensors", &m, sizeof m, err)))
         return st;
     f->nfluid = (size_t)sc.nfluid;
@@ -45,6 +59,10 @@ enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_
     f->step = (long)sc.step;
     f->lost = (long)sc.lost;
     f->wall_guard = (long)sc.wall_guard;
+    for (int k = 0; k < 4; k++)
+        f->wall_guard_face[k] = (long)g.face[k];
+    f->wall_guard_first_face = (int)g.first_face;
+    memcpy(f->wall_guard_first, g.first, sizeof g.first);
     f->solid_placed = (int)sc.solid_placed;
     fluid_sensors_back(f, &m);
     return MPS_OK;

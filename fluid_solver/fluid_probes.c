@@ -116,6 +116,20 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
     mps_json_int(j, "neighbour_builds", f->nbr_rebuilds);
     mps_json_int(j, "lost_particles", f->lost);
     mps_json_int(j, "wall_guard_uses", f->wall_guard);
+    /* where the guard was used, and its first use: a leak shows where it is */
+    static const char *const face[4] = {"floor", "left", "right", "lid"};
+    mps_json_object(j, "wall_guard_faces");
+    for (int k = 0; k < 4; k++)
+        mps_json_int(j, face[k], f->wall_guard_face[k]);
+    mps_json_close(j);
+    if (f->wall_guard > 0) {
+        mps_json_object(j, "wall_guard_first");
+        mps_json_num(j, "time", f->wall_guard_first[0]);
+        mps_json_str(j, "face", face[f->wall_guard_first_face]);
+        mps_json_num(j, "x", f->wall_guard_first[1]);
+        mps_json_num(j, "y", f->wall_guard_first[2]);
+        mps_json_close(j);
+    }
     mps_json_str(j, "ppe_solver", fluid_linsolve_method(f->ls));
     double total = mps_timer_total(&f->timer);
     mps_json_num(j, "step_seconds", total);

@@ -13,7 +13,11 @@
  *   - a plate two particles thick with water on both faces: no PPE entry
  *     couples one face's water or particles with the other's, the matrix
  *     stays symmetric, and a fluid particle that crept into the plate keeps
- *     its pairs (fluid.body_shadow, fluid_shadow.c). */
+ *     its pairs (fluid.body_shadow, fluid_shadow.c);
+ *   - the tank's walls close every corner when its width (or a lid's
+ *     height) is not a whole number of spacings (fluid_scene.c);
+ *   - the tank guard logs its use per face and its first use, and the
+ *     rollback image keeps that log. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -21,7 +25,9 @@
 
 #include "../test_util.h"
 #include "fluid.h"
+#include "fluid_checkpoint.h"
 #include "fluid_ppe.h"
+#include "fluid_scene.h"
 #include "fluid_shadow.h"
 #include "mps_case.h"
 #include "mps_kernel.h"
@@ -641,6 +647,127 @@ static void test_body_shadow(void)
     }
 }
 
+/* The first wall layer along one face: the coordinates (along the face) of
+ * the wall points at distance dp/2 behind it, both corner columns included,
+ * sorted; returns how many. */
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static size_t face_line(const struct fluid_scene_pt *pt, size_t n0, size_t n, int axis, double at,
+                        double dp, double *out)
+{
+    size_t m = 0;
+    for (size_t i = n0; i < n; i++)
+        if (fabs(pt[i].x[1 - axis] - at) < 1e-9 * dp)
+            out[m++] = pt[i].x[axis];
+    qsort(out, m, sizeof *out, cmp_double);
+    return m;
+}
+
+/* Largest and smallest gap between neighbouring points of a sorted line
+ * from lo to hi (the two corner columns' coordinates). */
+static void gaps(const double *x, size_t m, double lo, double hi, double *gmin, double *gmax)
+{
+    *gmin = 1e300;
+    *gmax = 0.0;
+    for (size_t k = 0; k + 1 < m; k++)
+        if (x[k] >= lo - 1e-12 && x[k + 1] <= hi + 1e-12) {
+            double g = x[k + 1] - x[k];
+            *gmin = g < *gmin ? g : *gmin;
+            *gmax = g > *gmax ? g : *gmax;
+        }
+}
+
+/* A tank 0.584 m wide is 194.67 spacings at 3 mm and 97.33 at 6 mm: the
+ * floor's lattice used to stop 1.67 and 1.33 dp short of the right wall's
+ * first column, a hole in the bottom-right corner that the 3 mm runs leaked
+ * through (the tank guard's 3-59 uses). The closed tank of the sloshing
+ * cases, 0.3445 m high, is 344.5 and 172.25 spacings at 1 and 2 mm: the
+ * same at the lid. Every gap along the floor (and the side walls of a closed
+ * tank) must now be 0.75-1.25 dp, and a whole number of spacings (4 mm) must
+ * give the plain lattice. */
+static void test_tank_corners(void)
+{
+    const struct {
+        double W, H, dp;
+        int lid;
+    } c[] = {{0.584, 0.584, 0.003, 0}, {0.584, 0.584, 0.006, 0}, {0.584, 0.584, 0.004, 0},
+             {0.609, 0.3445, 0.001, 1}, {0.609, 0.3445, 0.002, 1}};
+    for (size_t k = 0; k < sizeof c / sizeof *c; k++) {
+        struct fluid_params p;
+        memset(&p, 0, sizeof p);
+        p.dp = c[k].dp;
+        p.tank_w = c[k].W;
+        p.tank_h = c[k].H;
+        p.tank_lid = c[k].lid;
+        p.wall_layers = 3;
+        struct fluid_scene_pt *pt = NULL;
+        size_t nf = 0, nw = 0;
+        CHECK(fluid_scene_build(&p, &pt, &nf, &nw) == 0);
+        if (!pt)
+            continue;
+        const double dp = p.dp;
+        double *line = malloc((nw + 1) * sizeof *line), gmin, gmax;
+        /* the floor's first layer, from the left wall's column to the right's */
+        size_t m = face_line(pt, nf, nf + nw, 0, -0.5 * dp, dp, line);
+        gaps(line, m, -0.5 * dp, p.tank_w + 0.5 * dp, &gmin, &gmax);
+        printf("tank %.4g m at dp %g mm: floor gaps %.3f-%.3f dp\n", p.tank_w, 1e3 * dp,
+               gmin / dp, gmax / dp);
+        CHECK(gmin >= 0.75 * dp - 1e-12 && gmax <= 1.25 * dp + 1e-12);
+        if (fabs(p.tank_w / dp - round(p.tank_w / dp)) < 1e-6) {
+            CHECK_NEAR(gmin, dp, 1e-12);
+            CHECK_NEAR(gmax, dp, 1e-12);
+        }
+        if (p.tank_lid) {
+            /* the right wall's first column, from the floor's row to the lid's */
+            m = face_line(pt, nf, nf + nw, 1, p.tank_w + 0.5 * dp, dp, line);
+            gaps(line, m, -0.5 * dp, p.tank_h + 0.5 * dp, &gmin, &gmax);
+            printf("  side wall gaps %.3f-%.3f dp\n", gmin / dp, gmax / dp);
+            CHECK(gmin >= 0.75 * dp - 1e-12 && gmax <= 1.25 * dp + 1e-12);
+        }
+        free(line);
+        free(pt);
+    }
+}
+
+/* A particle pushed under the floor must be put back, counted on the floor
+ * with the step's time and where it was; a rollback restores the log. */
+static void test_guard_log(void)
+{
+    const char *sets[] = {"dp=0.01"};
+    struct fluid *f = make("cases/hydrostatic/case.yml", sets, 1);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    struct mps_err err = {0};
+    struct fluid_ckpt ck = {0};
+    CHECK(fluid_ckpt_save(f, &ck, &err) == MPS_OK);
+    size_t i = nearest_fluid(f, 0.3, 0.0);
+    f->x[i][1] = -0.2 * f->prm.dp;
+    CHECK(step(f, 1e-3) == MPS_OK);
+    printf("guard: %ld uses (floor %ld, left %ld, right %ld, lid %ld), first at t = %g s, "
+           "(%.4f, %.4f), face %d\n", f->wall_guard, f->wall_guard_face[0], f->wall_guard_face[1],
+           f->wall_guard_face[2], f->wall_guard_face[3], f->wall_guard_first[0],
+           f->wall_guard_first[1], f->wall_guard_first[2], f->wall_guard_first_face);
+    CHECK(f->wall_guard == 1 && f->wall_guard_face[0] == 1);
+    CHECK(f->wall_guard_first_face == 0);
+    CHECK_NEAR(f->wall_guard_first[0], 1e-3, 1e-12);
+    CHECK(f->wall_guard_first[2] < 0.0 && f->x[i][1] > 0.0);
+    struct fluid_ckpt after = {0};
+    CHECK(fluid_ckpt_save(f, &after, &err) == MPS_OK);
+    CHECK(fluid_ckpt_restore(f, &ck, &err) == MPS_OK);
+    CHECK(f->wall_guard == 0 && f->wall_guard_face[0] == 0);
+    CHECK(fluid_ckpt_restore(f, &after, &err) == MPS_OK);
+    CHECK(f->wall_guard_face[0] == 1 && f->wall_guard_first_face == 0);
+    CHECK_NEAR(f->wall_guard_first[0], 1e-3, 1e-12);
+    fluid_ckpt_free(&ck);
+    fluid_ckpt_free(&after);
+    fluid_destroy(&f);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -660,5 +787,7 @@ int main(int argc, char **argv)
     test_verlet_list();
     test_surface_double_check();
     test_body_shadow();
+    test_tank_corners();
+    test_guard_log();
     return test_summary("test_fluid_step");
 }
