@@ -513,16 +513,6 @@ static void surface_scan(struct fluid *f)
     }
 }
 
-/* Last-resort guard against leaking through the tank: a fluid particle whose
- * centre has crossed an inner face of the tank (below the top of the side
- * walls) is put back half a spacing inside and its normal velocity reflected
- * with the collision restitution. Each use is counted (f->wall_guard, in the
- * summary, per face, with the first use) so a run that leans on it shows.
- * What it used to catch (3 mm dam break to 0.5 s, 20 uses, logged): one or
- * two particles creeping down through the bottom-right corner, where the
- * floor's lattice stopped 1.67 dp short of the side wall (0.584 m is 194.67
- * spacings of 3 mm); fluid_scene.c closes such corners now, and the 3 mm
- * plate to 1 s went from 29 uses to none. */
 /* Counts one use of the guard on face (0 floor, 1 left, 2 right, 3 lid) by
  * the particle at x (before it is put back); the first use is kept whole,
  * for the summary: a leak shows where and when it started. */
@@ -538,6 +528,16 @@ static void guard_count(struct fluid *f, int face, const double *x)
     f->wall_guard_face[face]++;
 }
 
+/* Last-resort guard against leaking through the tank: a fluid particle whose
+ * centre has crossed an inner face of the tank (below the top of the side
+ * walls) is put back half a spacing inside and its normal velocity reflected
+ * with the collision restitution. Each use is counted (f->wall_guard, in the
+ * summary, per face, with the first use) so a run that leans on it shows.
+ * What it used to catch (3 mm dam break to 0.5 s, 20 uses, logged): one or
+ * two particles creeping down through the bottom-right corner, where the
+ * floor's lattice stopped 1.67 dp short of the side wall (0.584 m is 194.67
+ * spacings of 3 mm); fluid_scene.c closes such corners now, and the 3 mm
+ * plate to 1 s went from 29 uses to none. */
 static void guard_tank(struct fluid *f)
 {
     const struct fluid_params *p = &f->prm;
