@@ -197,7 +197,12 @@ def section_hydro(a, b):
     # kappa = 0.001 beside the default: the long run drifts with the default's
     # density correction, and the weaker one is the evidence of where from;
     # the quadratic weight holds the paper's kappa still (docs/pressure.md)
-    variants = (('default (fluid.kappa = 0.01)', [], ''), ('fluid.kappa = 0.001', ['fluid.kappa=0.001'], '_k001'),
+    # and the dead band off (Eq. 23 as printed, the default before 2026-12-03's
+    # twelfth session), the long run's drift that the band removed
+    variants = (('default (fluid.kappa = 0.01, fluid.density_dead_band = 0.001)', [], ''),
+                ('fluid.density_dead_band = 0 (Eq. 23 as printed)', ['fluid.density_dead_band=0'],
+                 '_band0'),
+                ('fluid.kappa = 0.001', ['fluid.kappa=0.001'], '_k001'),
                 ('fluid.density_weight = quadratic', ['fluid.density_weight=quadratic'], '_quadratic'))
     for tag, sets, suffix in variants:
         if a.hydro_only and a.hydro_only not in suffix + tag:

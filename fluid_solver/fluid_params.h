@@ -67,6 +67,7 @@ struct fluid_params {
     double kappa_dt;              /* s: steps shorter than this correct kappa dt / kappa_dt */
     double kappa_step_decay;      /* per step: how fast Eq. 23's reference step may fall */
     int density_quadratic;        /* Eq. 23's density error from mps_weight_quadratic */
+    double density_dead_band;     /* n0: Eq. 23 corrects only the error beyond this */
     double re_n, re_lap;          /* effective radii, multiples of dp */
     double beta1, beta2;          /* free-surface double check */
     double surface_scan;          /* empty-side confirmation radius, dp; 0 = off */

@@ -3,13 +3,16 @@
 
 usage: check_dambreak.py RUN_DIR [--tmax 3] [--max-front-err 0.25]
                          [--mean-front-err 0.15] [--speed-err 0.10]
+                         [--speed-err-high E]
                          [--max-height-err 0.18] [--mean-height-err 0.10]
                          [--shift DT --shifted-max-err E --shifted-mean-err E]
 Uses bench/dambreak_compare.py (reference: cases/dambreak/martin_moyce.csv).
   - the run reached T = tmax;
   - front Z(T): max and mean relative error over the table points up to tmax;
   - front speed: the least-squares slope dZ/dT over the table points with
-    1.4 <= T <= tmax, simulated vs measured, within speed-err. The simulated
+    1.4 <= T <= tmax, simulated vs measured, within speed-err (on the fast
+    side within --speed-err-high if given: the measure's own noise is
+    one-sided, see tests/fluid/validation.cmake). The simulated
     front leads the measured one by an offset gained before T ~ 1.2 (the
     experiment's release; docs/fluid.md), after which both travel at the same
     speed: this check holds the later motion to a tighter bound;
@@ -44,6 +47,8 @@ def main():
     ap.add_argument('--max-front-err', type=float, default=0.25)
     ap.add_argument('--mean-front-err', type=float, default=0.15)
     ap.add_argument('--speed-err', type=float, default=0.10)
+    ap.add_argument('--speed-err-high', type=float, default=None,
+                    help='the band on the fast side (default: --speed-err)')
     ap.add_argument('--max-height-err', type=float, default=0.18)
     ap.add_argument('--mean-height-err', type=float, default=0.10)
     ap.add_argument('--shift', type=float, default=None,
@@ -73,14 +78,15 @@ def main():
     hmax, hmean = r['height_max_rel_err'], r['height_mean_rel_err']
     print(f"front: max |err| {100 * fmax:.1f}% (tol {100 * a.max_front_err:.1f}%), mean "
           f"{100 * fmean:.1f}% (tol {100 * a.mean_front_err:.1f}%)")
+    s_high = a.speed_err if a.speed_err_high is None else a.speed_err_high
     print(f"front speed dZ/dT for T >= 1.4: measured {s_exp:.3f}, simulated {s_sim:.3f} "
-          f"({100 * s_err:+.1f}%, tol {100 * a.speed_err:.1f}%)")
+          f"({100 * s_err:+.1f}%, tol -{100 * a.speed_err:.1f}% / +{100 * s_high:.1f}%)")
     print(f"height: max |err| {100 * hmax:.1f}% (tol {100 * a.max_height_err:.1f}%), mean "
           f"{100 * hmean:.1f}% (tol {100 * a.mean_height_err:.1f}%) over {len(r['height'])} "
           f"points")
     if fmax > a.max_front_err or fmean > a.mean_front_err:
         bad.append('front position')
-    if abs(s_err) > a.speed_err:
+    if s_err < -a.speed_err or s_err > s_high:
         bad.append('front speed')
     if hmax > a.max_height_err or hmean > a.mean_height_err:
         bad.append('height at the wall')

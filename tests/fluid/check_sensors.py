@@ -20,6 +20,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fluid_run  # noqa: E402
 
 RHO, G = 1000.0, 9.81
+COLUMN_H = 0.292  # the dam break's water column, m (cases/dambreak)
 bad = []
 
 
@@ -87,13 +88,23 @@ def dambreak(a):
     c = 1.0 / math.sqrt(RHO * alpha)
     print(f'front at the wall at t = {t_a:.4f} s, arriving at U = {U:.2f} m/s: stagnation '
           f'pressure rho U^2 / 2 = {p_stag:.0f} Pa, water hammer rho c U = {RHO * c * U:.0f} Pa')
-    # A sensor reads the fluid within 1.5 dp of the wall: while the leading
-    # particle is farther (front < W - 2 dp) it must read exactly 0 (dry).
+    # A sensor reads the fluid within 1.5 dp of the wall: while the front
+    # is farther (front < W - 2 dp) it is dry but for spray. The front
+    # probe leaves out droplets, and a droplet thrown ahead of the front
+    # may touch the wall first: with the dead band (2026-12-03) the 8 mm
+    # run throws one 12 ms ahead, and the sensor reads 2-17 Pa, the wall
+    # 0.02-0.15 N/m while it is there. A sensor that read the wall's own
+    # pressure or the water beyond its reach would read hundreds of Pa. So
+    # dry rows must read under 1% of the stagnation pressure, and the wall
+    # under 1% of it over the column's height (9 N/m; the impact's 580).
     dry = [r for r in rows if r['front'] < W - 2.0 * dp and r['time'] < t_a]
-    wet_early = [r for r in dry if r[p] != 0.0 or r['force_right'] != 0.0]
+    wet_early = [r for r in dry if abs(r[p]) > 0.01 * p_stag or
+                 abs(r['force_right']) > 0.01 * p_stag * COLUMN_H]
+    spray = [r for r in dry if r[p] != 0.0 or r['force_right'] != 0.0]
     check(bool(dry) and not wet_early,
-          f'{p} and force_right read 0 while the water is away from the wall '
-          f'({len(dry)} rows, {len(wet_early)} not 0)')
+          f'{p} and force_right read (almost) 0 while the water is away from the wall '
+          f'({len(dry)} rows, {len(spray)} touched by spray, {len(wet_early)} over 1% of '
+          f'rho U^2/2 = {0.01 * p_stag:.0f} Pa or {0.01 * p_stag * COLUMN_H:.1f} N/m)')
     # The rise: the first row at half the stagnation pressure. The water must
     # pile up at the wall to the sensor's face (12-20 mm) at about the front
     # speed, 8 ms at 2.5 m/s, and a row is a mean over its interval (2 ms):
@@ -113,7 +124,7 @@ def dambreak(a):
     peak = max(imp, key=lambda r: r[p])
     hyd = max(RHO * G * max(0.0, r['h_wall'] - y_s) for r in imp)
     print(f'peak {peak[p]:.0f} Pa at t = {peak["time"]:.4f} s ({peak[p] / p_stag:.2f} x rho U^2/2, '
-          f'{peak[p] / (RHO * G * 0.292):.2f} x rho g H); the water at the wall stands at most '
+          f'{peak[p] / (RHO * G * COLUMN_H):.2f} x rho g H); the water at the wall stands at most '
           f'{max(r["h_wall"] for r in imp) * 1e3:.0f} mm then: {hyd:.0f} Pa hydrostatic at the sensor')
     check(peak[p] >= p_stag, f'impact peak {peak[p]:.0f} Pa >= rho U^2 / 2 = {p_stag:.0f} Pa')
     check(peak[p] >= 3.0 * hyd, f'impact peak {peak[p]:.0f} Pa >= 3 x hydrostatic {hyd:.0f} Pa')

@@ -334,24 +334,40 @@ static void test_ppe_terms(void)
     printf("PPE Laplacian (Eq. 12): |a_ij + 2d/(lambda n0) w_ij| <= %.3g of %.3g\n", aworst, abig);
     CHECK(abig > 0.0 && aworst <= 1e-9 * abig);
     free(part);
+    /* fluid.density_dead_band: Eq. 23 on the error beyond the band, none
+     * inside it; with the band at 0 (below), Eq. 23 as printed */
+    const double band = p->density_dead_band * f->n0;
+    CHECK(band > 0.0);
     double worst = 0.0, big = 0.0;
-    int rows = 0, off = 0;
+    int rows = 0, off = 0, inside = 0;
     for (size_t i = 0; i < f->ps.n; i++) {
         int r = f->row[i];
         if (r < 0)
             continue;
-        double want = p->kappa * p->rho / (dt * dt) * (f->nd[i] - f->n0) / f->n0;
+        double dn = f->nd[i] - f->n0;
+        double excess = dn > band ? dn - band : dn < -band ? dn + band : 0.0;
+        double want = p->kappa * p->rho / (dt * dt) * excess / f->n0;
         worst = fmax(worst, fabs(f->rhs[r] - want));
         big = fmax(big, fabs(want));
         off += f->nd[i] != f->n0;
+        inside += dn != 0.0 && fabs(dn) <= band;
         for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++)
             if (f->col[k] == r)
                 diag[r] = f->val[k];
         rows++;
     }
-    printf("PPE source (Eq. 23): %d rows (%d off n0), |rhs - kappa rho/dt^2 dn/n0| <= %.3g of "
-           "%.3g\n", rows, off, worst, big);
-    CHECK(rows >= 50 && off > rows / 2);
+    printf("PPE source (Eq. 23, dead band %.3g n0): %d rows (%d off n0, %d of them inside the "
+           "band), |rhs - kappa rho/dt^2 (dn -+ band)/n0| <= %.3g of %.3g\n",
+           p->density_dead_band, rows, off, inside, worst, big);
+    CHECK(rows >= 50 && off > rows / 2 && inside > 0 && inside < off);
+    CHECK(worst <= 1e-12 * big);
+    f->prm.density_dead_band = 0.0;
+    CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
+    worst = 0.0;
+    for (size_t i = 0; i < f->ps.n; i++)
+        if (f->row[i] >= 0)
+            worst = fmax(worst, fabs(f->rhs[f->row[i]] - p->kappa * p->rho / (dt * dt) *
+                                                           (f->nd[i] - f->n0) / f->n0));
     CHECK(worst <= 1e-12 * big);
     /* kappa_dt longer than the step: the fixed rate kappa / kappa_dt */
     f->prm.kappa_dt = 4.0 * dt;

@@ -43,7 +43,15 @@ add_test(NAME fluid_valid_hydrostatic
 #    before; at 4 mm +2.9% against +8.0% before (one thread). The band was
 #    1.5% on the earlier build's -0.5% alone; 3% holds the measured spread
 #    of these numerics changes and still catches Eq. 17's position 10% short
-#    (-9.2%). The other measures below improved with that change;
+#    (-9.2%). The other measures below improved with that change.
+#    On the fast side the band is 8% (2026-12-03, the density dead band):
+#    the measure's noise is one-sided. Until T = 1.9 the front of runs with
+#    the band at 0, 0.0001, 0.0002, 0.0003, 0.0005 and 0.001 n0 agrees to
+#    0.1 mm; then the sheet's tip thins, and its leading particle either
+#    leaves as spray (the front probe drops it and falls back 1-2 dp, once)
+#    or stays. Read at the table points the six give +2.2, +6.8, +0.3, +0.5,
+#    +6.0 and +0.0%: the runs whose tip stays read the sheet's own speed,
+#    up to +7%. The slow side keeps 3%, which the fault above crosses;
 #  - front against the measurements 17 ms later (--shift 0.2: the release
 #    time of the experiment's diaphragm, docs/fluid.md): max 10% (measured
 #    8.9%; 8.9% since the spray change), mean 3.5% (2.8%; 2.3%);
@@ -57,7 +65,7 @@ add_test(NAME fluid_valid_hydrostatic
 # bands (25/15% front, 10% speed, 18/10% height) passed both.
 add_test(NAME fluid_valid_dambreak
   COMMAND ${FV_RUN} ${FV_OUT}/dambreak ${FV_DIR}/check_dambreak.py
-          --max-front-err 0.21 --mean-front-err 0.135 --speed-err 0.03
+          --max-front-err 0.21 --mean-front-err 0.135 --speed-err 0.03 --speed-err-high 0.08
           --max-height-err 0.11 --mean-height-err 0.045
           --shift 0.2 --shifted-max-err 0.10 --shifted-mean-err 0.035
           -- ${FV_SOLVER} cases/dambreak/case.yml --set dp=0.008 --set end_time=0.27
@@ -91,8 +99,33 @@ add_test(NAME fluid_still_water_10s
           -- ${FV_SOLVER} cases/hydrostatic/case.yml --set end_time=10 --set output.interval=0
              --set fluid.density_weight=quadratic
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# fluid_still_water_default_10s, fluid_still_water_short_steps: the same
+# bands with the defaults, Eq. 7's weight and fluid.density_dead_band 0.0005,
+# at the case's 1 ms steps for 10 s and at 0.2 ms steps (a correction rate of
+# 50/s, the fine runs' regime) for 4 s, the pressure judged after 0.5 s there
+# (leaving the hydrostatic guess rings to +3% for 0.06 s at that step).
+# Measured (2026-12-03, band 0.0005): 1 ms, bottom pressure -0.06% mean,
+# -0.07% worst, std 0.14 Pa, largest speed 1.2e-3 m/s (at 0.01 s), under
+# 1e-4 m/s after 1 s; 0.2 ms, -0.05% mean and worst after 0.5 s, std
+# 0.03 Pa, largest speed 3.2e-3 m/s (0.01 s), 2.7e-4 after 1 s; volume
+# -0.01% in 10 s at either step (bench/water_volume.py). With the band at 0
+# (Eq. 23 as printed) both fail: at 1 ms the water moves at 0.26 m/s by
+# 7.8 s and its bottom pressure reads +1.2% on average; at 0.2 ms 0.85 m/s,
+# +1.7% (docs/pressure.md, "A sixth remedy").
+add_test(NAME fluid_still_water_default_10s
+  COMMAND ${FV_RUN} ${FV_OUT}/still_default_10s ${FV_DIR}/check_hydrostatic.py --t-end 10
+          --surface-dp 0.01 --p-tol 0.005
+          -- ${FV_SOLVER} cases/hydrostatic/case.yml --set end_time=10 --set output.interval=0
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME fluid_still_water_short_steps
+  COMMAND ${FV_RUN} ${FV_OUT}/still_short_steps ${FV_DIR}/check_hydrostatic.py --t-end 4
+          --surface-dp 0.01 --p-tol 0.005 --t-start 0.5
+          -- ${FV_SOLVER} cases/hydrostatic/case.yml --set end_time=4 --set output.interval=0
+             --set fluid.dt_max=2e-4
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(fluid_valid_hydrostatic fluid_valid_dambreak fluid_stable_dambreak
   fluid_ppe_scaling fluid_pressure_flicker fluid_still_water_10s
+  fluid_still_water_default_10s fluid_still_water_short_steps
   PROPERTIES LABELS validation TIMEOUT 180 ENVIRONMENT "OMP_NUM_THREADS=1")
 
 # Standalone runs bind their OpenMP threads to CPUs unless the user (or the
