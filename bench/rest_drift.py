@@ -3,6 +3,7 @@
 well one run can know it.
 
 usage: bench/rest_drift.py RUN [RUN...] [--fe M] [--ref M] [--block S] [--fit-end T]
+                           [--fit-start T] [--per S]
 
 The issue's drift is the mean tip_dx over 4-5 s minus the mean over 1-2 s.
 The plate rings with the water about its mean (the water's seiches and the
@@ -71,7 +72,11 @@ def main():
     ap.add_argument('--block', type=float, default=0.5)
     ap.add_argument('--fit-end', type=float, default=5.0,
                     help='end of the fit window, s (a longer run narrows the slope: its '
-                         'drift is then given per 4 s, as over 1-5 s)')
+                         'drift is then given per --per s)')
+    ap.add_argument('--fit-start', type=float, default=1.0,
+                    help='start of the fit window, s (2: after the release has settled)')
+    ap.add_argument('--per', type=float, default=4.0,
+                    help='the fitted drift per this many seconds (4: as over 1-5 s)')
     a = ap.parse_args()
     a.ref = a.ref or a.fe
     for run in a.runs:
@@ -80,12 +85,20 @@ def main():
         if t[-1] < max(5.0, a.fit_end) - 1e-6:
             print(f'{run}: reached {t[-1]:.3f} s, not {max(5.0, a.fit_end):g} s: no drift')
             continue
-        m45, d45, fit, se, s = drift(t, x, a.block, t1=a.fit_end)
-        fit, se = fit * 4.0 / (a.fit_end - 1.0), se * 4.0 / (a.fit_end - 1.0)
+        m45, d45, fit, se, s = drift(t, x, a.block, t0=a.fit_start, t1=a.fit_end)
+        span = a.fit_end - a.fit_start
+        fit, se = fit * a.per / span, se * a.per / span
         print(f'{run}: mean 4-5 s {1e3 * m45:.3f} mm ({100 * (m45 / a.fe - 1):+.1f}% of '
               f'{1e3 * a.fe:.3f}); drift 1-2 -> 4-5 s {100 * d45 / a.ref:+.2f}%; '
-              f'fit over 1-{a.fit_end:g} s, per 4 s: {100 * fit / a.ref:+.2f}% +- {100 * se / a.ref:.2f}% '
-              f'({a.block:g} s blocks scatter {1e3 * s:.3f} mm)')
+              f'fit over {a.fit_start:g}-{a.fit_end:g} s, per {a.per:g} s: {100 * fit / a.ref:+.2f}% '
+              f'+- {100 * se / a.ref:.2f}% ({a.block:g} s blocks scatter {1e3 * s:.3f} mm)')
+        if 'p_left' in d.dtype.names:
+            # the water's level: the left basin's bottom pressure (rho g h' with h' the
+            # level its closed volume holds: 569.7 Pa at 3 mm, docs/hard_cases.md)
+            p = d['p_left']
+            last = np.floor(t[-1] + 1e-9)
+            print(f'{run}: left bottom pressure {p[(t >= 1) & (t <= 2)].mean():.1f} Pa over 1-2 s, '
+                  f'{p[(t >= last - 1) & (t <= last)].mean():.1f} Pa over {last - 1:g}-{last:g} s')
 
 
 if __name__ == '__main__':

@@ -79,8 +79,16 @@ set_tests_properties(coupled_light_plate_implicit coupled_light_plate_explicit_u
 # surface (fluid.surface_scan_density 0.9, the default since then; two
 # threads: 5.150 before, 5.553 mm after, over 1-2 s). The water 10% lighter
 # (4.741 mm explicit) stays outside the lower limit, which is unchanged.
+# Since 2026-12-03 (twelfth session) the case sets fluid.shifting: 10, which
+# keeps the sloshing basins' water from expanding over 10 s at 3 mm
+# (docs/hard_cases.md, "Particle shifting for the sloshing basins"). At 6 mm
+# it reads higher: 5.307 / 5.361 mm implicit and 5.358 / 5.433 mm explicit at
+# 1 / 2 threads (+2.6% to +5.0% of the FE). The implicit band's upper limit
+# moves to the explicit one's, +10%: its two-thread run left 1.3% of margin
+# under +5%. The faults, measured again at two threads: the water 10% heavier
+# reads 5.869 mm (implicit), 10% lighter 4.813 mm (explicit), both outside.
 set(rest_band_explicit "0.004915 0.005691")
-set(rest_band_implicit "0.004915 0.005433")
+set(rest_band_implicit "0.004915 0.005691")
 foreach(scheme explicit implicit)
   add_test(NAME coupled_plate_at_rest_${scheme}
            COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_plate_at_rest/case.yml --quiet --set dp=0.006 --set end_time=2 --set output.interval=0 --set solid.refine=4 --set fluid.body_shadow=true --set coupling.scheme=${scheme} --out ${CMAKE_BINARY_DIR}/test_out/rest_${scheme}; /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/rest_${scheme} --end 2 --tip-bound 0.03 --static ${rest_band_${scheme}} 1 2"
@@ -95,7 +103,9 @@ endforeach()
 # here (the water sits 0.6-0.8 dp from the plate, and Eq. 50's lattice
 # calibration does not hold there: docs/pressure.md). The band, 5%, is three
 # times the measured error: the fluid's pressure next to the plate is
-# hydrostatic within 2%.
+# hydrostatic within 2%. With the case's shifting of 2026-12-03
+# (fluid.shifting: 10): -0.4% / -1.1% here, +3.4% / -3.1% in the 6 mm test
+# below (+2.6% / -3.3% before).
 add_test(NAME coupled_rigid_plate_still_load
          COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/hard_plate_at_rest/case.yml --quiet --set dp=0.003 --set end_time=1 --set output.interval=0 --solid ${CMAKE_BINARY_DIR}/bin/fake_solid --out ${CMAKE_BINARY_DIR}/test_out/rest_rigid && /usr/bin/python3 tests/coupler/hard_check.py ${CMAKE_BINARY_DIR}/test_out/rest_rigid --end 1 --still-load 0.072 0.024 0.003 0.05 0.5 1"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
