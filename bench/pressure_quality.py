@@ -199,7 +199,7 @@ def section_hydro(a, b):
     # the quadratic weight holds the paper's kappa still (docs/pressure.md)
     # and the dead band off (Eq. 23 as printed, the default before 2026-12-03's
     # twelfth session), the long run's drift that the band removed
-    variants = (('default (fluid.kappa = 0.01, fluid.density_dead_band = 0.001)', [], ''),
+    variants = (('default (fluid.kappa = 0.01, fluid.density_dead_band = 0.0005)', [], ''),
                 ('fluid.density_dead_band = 0 (Eq. 23 as printed)', ['fluid.density_dead_band=0'],
                  '_band0'),
                 ('fluid.kappa = 0.001', ['fluid.kappa=0.001'], '_k001'),
