@@ -112,6 +112,7 @@ struct fluid {
     int *aggmap;
     size_t cap_aggkey, cap_aggmap;
     double skin;
+    double side_wall_rate;        /* 1/s: the side walls' drag per unit velocity (0: none) */
     /* PPE */
     int nrows;
     int *rowptr, *col;

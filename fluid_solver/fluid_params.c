@@ -97,6 +97,15 @@ const struct mps_key_spec fluid_case_keys[] = {
      "fluid particles closer than this are pushed apart (0: off)"},
     {"fluid.collision_restitution", MPS_KEY_DOUBLE, "0.2", 0, 1, 0, NULL, "",
      "restitution of that collision"},
+    {"fluid.side_walls.breadth", MPS_KEY_DOUBLE, "0", 0, 0, NOHI, NULL, "m",
+     "the tank's breadth between its two side walls, for a 2D run of a narrow tank: the "
+     "walls' oscillating (Stokes) boundary layers retard the flow by sqrt(2 nu omega) / "
+     "breadth times its velocity in the tank (the in-phase part of their shear, averaged "
+     "over the breadth; omega = 2 pi / fluid.side_walls.period). 0 (default): no side "
+     "walls, the paper's 2D flow (docs/sloshing.md, \"Side walls\")"},
+    {"fluid.side_walls.period", MPS_KEY_DOUBLE, "0", 0, 0, NOHI, NULL, "s",
+     "the period of the oscillation the side walls' boundary layers are taken at; 0 "
+     "(default): the tank's motion.period (a sinusoidal motion)"},
     {"fluid.shifting", MPS_KEY_DOUBLE, "2.0", 0, 0, NOHI, NULL, "",
      "particle shifting coefficient A of dr = -A dp |v| dt grad n / n0 (0: off)"},
     {"fluid.shifting_max", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "dp",
@@ -307,6 +316,21 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->clamp_negative = mps_case_bool(c, "fluid.clamp_negative");
     p->collision_dist = mps_case_double(c, "fluid.collision_distance");
     p->collision_restitution = mps_case_double(c, "fluid.collision_restitution");
+    p->side_wall_breadth = mps_case_double(c, "fluid.side_walls.breadth");
+    p->side_wall_period = mps_case_double(c, "fluid.side_walls.period");
+    /* the Stokes layer's frequency: a sinusoidal roll gives it (its
+     * period, eq55 included, is resolved with the motion: fluid_create) */
+    if (p->side_wall_breadth > 0.0 && !(p->side_wall_period > 0.0) &&
+        strcmp(mps_case_string(c, "motion.kind"), "sinusoid") != 0)
+        return mps_case_fail(c, err, "fluid.side_walls.breadth",
+                             "needs fluid.side_walls.period (s) when the tank does not roll "
+                             "sinusoidally (motion.kind = %s): the side walls' boundary layers "
+                             "are taken at one period of oscillation",
+                             mps_case_string(c, "motion.kind"));
+    if (p->side_wall_breadth > 0.0 && !(p->nu > 0.0))
+        return mps_case_fail(c, err, "fluid.side_walls.breadth",
+                             "needs a viscous fluid (fluid.nu > 0): the side walls' drag is "
+                             "viscous");
     p->shift_coef = mps_case_double(c, "fluid.shifting");
     p->shift_max = mps_case_double(c, "fluid.shifting_max");
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");

@@ -81,6 +81,8 @@ struct fluid_params {
     int clamp_negative;           /* negative PPE pressures set to 0 */
     double collision_dist;        /* fraction of dp; 0 = off */
     double collision_restitution;
+    double side_wall_breadth;     /* m: 0 = no side walls (2D) */
+    double side_wall_period;      /* s: their boundary layers' period; 0 = the motion's */
     double shift_coef, shift_max; /* particle shifting: A (0 = off), cap in dp */
     const char *ppe_solver;
     int step_log;                 /* write PREFIX_steps.csv */

@@ -784,6 +784,49 @@ static void test_guard_log(void)
     fluid_destroy(&f);
 }
 
+/* fluid.side_walls: the rate is Stokes' in-phase shear over the breadth,
+ * sqrt(2 nu omega) / B, and the prediction divides v + dt (visc + acc) by
+ * 1 + c dt, all of it and nothing else. Two dam breaks stepped alike for a
+ * step (the drag held off in one), then one step with it: every fluid
+ * particle's v* is the other's times 1 / (1 + c dt). B is made small (5 mm)
+ * so that the factor, 0.9985, stands well out of the rounding. */
+static void test_side_walls(void)
+{
+    const char *base[] = {"dp=0.02", "fluid.nu=5e-5"};
+    const char *walls[] = {"dp=0.02", "fluid.nu=5e-5", "fluid.side_walls.breadth=0.005",
+                           "fluid.side_walls.period=1.6466"};
+    struct fluid *f0 = make("cases/dambreak/case.yml", base, 2);
+    struct fluid *f1 = make("cases/dambreak/case.yml", walls, 4);
+    CHECK(f0 && f1);
+    if (!f0 || !f1)
+        return;
+    const double two_pi = 6.283185307179586;
+    const double want = sqrt(2.0 * 5e-5 * two_pi / 1.6466) / 0.005;
+    printf("side walls: rate %.6f 1/s (Stokes sqrt(2 nu omega) / B: %.6f)\n", f1->side_wall_rate,
+           want);
+    CHECK_NEAR(f1->side_wall_rate, want, 1e-12 * want);
+    CHECK(f0->side_wall_rate == 0.0);
+    const double rate = f1->side_wall_rate, dt = 1e-3;
+    f1->side_wall_rate = 0.0;
+    CHECK(step(f0, dt) == MPS_OK && step(f1, dt) == MPS_OK);
+    f1->side_wall_rate = rate;
+    CHECK(step(f0, dt) == MPS_OK && step(f1, dt) == MPS_OK);
+    const double keep = 1.0 / (1.0 + dt * rate);
+    double worst = 0.0, vmax = 0.0;
+    CHECK(f0->nfluid == f1->nfluid);
+    for (size_t i = 0; i < f0->nfluid && i < f1->nfluid; i++)
+        for (int d = 0; d < MPS_DIM; d++) {
+            worst = fmax(worst, fabs(f1->vstar[i][d] - keep * f0->vstar[i][d]));
+            vmax = fmax(vmax, fabs(f0->vstar[i][d]));
+        }
+    printf("side walls: |v*(walls) - v*(none) / (1 + c dt)| <= %.3g m/s (v* up to %.3g m/s, "
+           "the drag takes %.3g)\n", worst, vmax, (1.0 - keep) * vmax);
+    CHECK(vmax > 0.01);
+    CHECK(worst <= 1e-12 * vmax);
+    fluid_destroy(&f0);
+    fluid_destroy(&f1);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -805,5 +848,6 @@ int main(int argc, char **argv)
     test_body_shadow();
     test_tank_corners();
     test_guard_log();
+    test_side_walls();
     return test_summary("test_fluid_step");
 }
