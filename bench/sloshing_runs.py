@@ -112,13 +112,17 @@ def do_run(name, spec, out, force, extra, coupler=COUPLER):
     subprocess.run(cmd)
 
 
-def cycles(t, x, lo, hi, band=0.5):
+def cycles(t, x, lo, hi, band=1.0):
     """Cycles of x between up-crossings of its mean over [lo, hi]: list of
     (t_start, t_end, max, min). An up-crossing counts only after x has been
     below the mean by band x its standard deviation since the last one: a
     refined plate (solid.refine) rings at its own ~10 Hz on top of the roll's
     period, and each ripple through the mean would otherwise start a cycle
-    (a sinusoid's crossings are untouched: it dips to -1.4 std)."""
+    (a sinusoid's crossings are untouched: it dips to -1.4 std). Half a
+    standard deviation, the first choice, let a ripple of the low filling's
+    2 mm refined plate through (2026-12-03: three "cycles" of 1.11 s where
+    there are two of 1.67); one is still clear of the sinusoid's trough, and
+    reads every other run of this page as before."""
     m = (t >= lo) & (t <= hi)
     tt, xx = t[m], x[m]
     if len(tt) < 3:
