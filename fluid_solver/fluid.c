@@ -138,9 +138,12 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
      * retards the flow at sqrt(2 nu omega) / b per unit velocity. It is
      * the sloshing's damping that the 2D model leaves out (zeta about 0.06
      * for the oil tank of docs/sloshing.md, "Side walls"). The reactive
-     * half, an inertia of delta / b (11-13% there) that lowers the sloshing
-     * frequency by about zeta, is left out: it would act on the pressure's
-     * correction as well, inside the projection. */
+     * half, of the same size, is an inertia: the layers' fluid moves with
+     * the flow, delta / b more of it (11-13% there), and it lowers the
+     * sloshing frequency by about zeta. It multiplies the flow's whole
+     * inertia, so the pressure correction accelerates rho (1 + delta / b)
+     * (fluid_ppe.c, the projection) while the pressure stays the physical
+     * one: hydrostatic under gravity, the loads as they are. */
     if (prm->side_wall_breadth > 0.0) {
         const double period = prm->side_wall_period > 0.0 ? prm->side_wall_period
                               : prm->motion                ? prm->motion->period
@@ -153,7 +156,10 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
         }
         const double omega = 6.283185307179586 / period;
         f->side_wall_rate = sqrt(2.0 * prm->nu * omega) / prm->side_wall_breadth;
+        if (prm->side_wall_inertia)
+            f->side_wall_inertia = sqrt(2.0 * prm->nu / omega) / prm->side_wall_breadth;
     }
+    f->rho_inertial = prm->rho * (1.0 + f->side_wall_inertia);
     if (fluid_scene_build(prm, &pts, &nf, &nw)) {
         st = mps_err_set(err, MPS_ENOMEM, "fluid: out of memory building the tank");
         goto fail;
@@ -681,13 +687,16 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     if (p->nu > 0.0)
         mps_ops_laplacian_vec(&lap_in, f->n0_lap, f->lambda_lap,
                               (const double(*)[MPS_DIM])f->v, f->lap);
-    /* the side walls' drag (fluid_create), implicit: stable at any step */
-    const double side_keep = 1.0 / (1.0 + dt * f->side_wall_rate);
+    /* the side walls (fluid_create): (1 + m) dv/dt = visc + acc - c v, the
+     * drag implicit so stable at any step; without them m = c = 0 and the
+     * factors are exactly 1 */
+    const double side_mass = 1.0 + f->side_wall_inertia;
+    const double side_keep = 1.0 / (side_mass + dt * f->side_wall_rate);
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < nf; i++)
         for (int d = 0; d < MPS_DIM; d++) {
             double visc = p->nu > 0.0 ? p->nu * f->lap[i][d] : 0.0;
-            f->vstar[i][d] = (f->v[i][d] + dt * (visc + f->acc[i][d])) * side_keep;
+            f->vstar[i][d] = (side_mass * f->v[i][d] + dt * (visc + f->acc[i][d])) * side_keep;
             f->x[i][d] += dt * f->vstar[i][d];
         }
     mps_timer_switch(&f->timer, PH_NBR);
@@ -773,7 +782,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
                                    f->fallback);
     else
         mps_ops_gradient(&g_in, f->n0, f->p, p->gradient_min, f->grad);
-    const double c = dt / p->rho;
+    const double c = dt / f->rho_inertial;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < nf; i++)
         for (int d = 0; d < MPS_DIM; d++) {

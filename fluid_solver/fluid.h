@@ -113,6 +113,9 @@ struct fluid {
     size_t cap_aggkey, cap_aggmap;
     double skin;
     double side_wall_rate;        /* 1/s: the side walls' drag per unit velocity (0: none) */
+    double side_wall_inertia;     /* delta / b: the side walls' added inertia (0: none) */
+    double rho_inertial;          /* kg/m3: rho (1 + side_wall_inertia), what the pressure
+                                   * gradient accelerates (rho without side walls) */
     /* PPE */
     int nrows;
     int *rowptr, *col;

@@ -106,6 +106,11 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.side_walls.period", MPS_KEY_DOUBLE, "0", 0, 0, NOHI, NULL, "s",
      "the period of the oscillation the side walls' boundary layers are taken at; 0 "
      "(default): the tank's motion.period (a sinusoidal motion)"},
+    {"fluid.side_walls.inertia", MPS_KEY_BOOL, "true", 0, 0, 0, NULL, "",
+     "with fluid.side_walls.breadth: also the reactive half of the layers' shear, an "
+     "inertia of delta / breadth (delta = sqrt(2 nu / omega)) on the flow and its pressure "
+     "correction, which lowers the sloshing frequency by about the damping ratio; false: "
+     "the drag alone"},
     {"fluid.shifting", MPS_KEY_DOUBLE, "2.0", 0, 0, NOHI, NULL, "",
      "particle shifting coefficient A of dr = -A dp |v| dt grad n / n0 (0: off)"},
     {"fluid.shifting_max", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "dp",
@@ -318,6 +323,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->collision_restitution = mps_case_double(c, "fluid.collision_restitution");
     p->side_wall_breadth = mps_case_double(c, "fluid.side_walls.breadth");
     p->side_wall_period = mps_case_double(c, "fluid.side_walls.period");
+    p->side_wall_inertia = mps_case_bool(c, "fluid.side_walls.inertia");
     /* the Stokes layer's frequency: a sinusoidal roll gives it (its
      * period, eq55 included, is resolved with the motion: fluid_create) */
     if (p->side_wall_breadth > 0.0 && !(p->side_wall_period > 0.0) &&

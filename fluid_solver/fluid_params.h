@@ -83,6 +83,7 @@ struct fluid_params {
     double collision_restitution;
     double side_wall_breadth;     /* m: 0 = no side walls (2D) */
     double side_wall_period;      /* s: their boundary layers' period; 0 = the motion's */
+    int side_wall_inertia;        /* the layers' reactive half too (an inertia), not the drag only */
     double shift_coef, shift_max; /* particle shifting: A (0 = off), cap in dp */
     const char *ppe_solver;
     int step_log;                 /* write PREFIX_steps.csv */

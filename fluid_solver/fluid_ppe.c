@@ -256,7 +256,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
      * break's column: 90% of it at P = 0 after 1.6 ms, 20 ms to recover
      * (docs/pressure.md). */
     const int first = f->step == 0 && p->mixed_source && ghosts;
-    const double comp = first ? 0.0 : p->rho * p->alpha / (dt * dt);
+    const double comp = first ? 0.0 : f->rho_inertial * p->alpha / (dt * dt);
     /* Eq. 23's kappa rho/dt^2 corrects a fraction kappa of the density
      * error per step: its pressure scales as 1/dt^2, so a step halved (an
      * output time, an impact) quadrupled it, and the persistent deficit
@@ -284,10 +284,12 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     if (p->kappa_step_decay > 0.0 && p->kappa_step_decay * f->dt_kappa > dtk)
         dtk = p->kappa_step_decay * f->dt_kappa;
     f->last.dt_kappa = dtk;
-    const double src = p->kappa * p->rho / (dt * dtk) / f->n0;
+    const double src = p->kappa * f->rho_inertial / (dt * dtk) / f->n0;
     const double band = p->density_dead_band * f->n0;
     const int mixed = p->mixed_source;
-    const double div_coef = p->rho / dt;
+    /* rho_inertial: rho, or with side walls rho (1 + delta / b), the inertia
+     * the pressure's correction moves (fluid_create) */
+    const double div_coef = f->rho_inertial / dt;
 
     /* pass 1: weights, and entries per row (+1 for the diagonal); the
      * diagonal sum goes to rhs temporarily */

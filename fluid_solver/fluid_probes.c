@@ -130,8 +130,10 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
         mps_json_num(j, "y", f->wall_guard_first[2]);
         mps_json_close(j);
     }
-    if (f->side_wall_rate > 0.0)
+    if (f->side_wall_rate > 0.0) {
         mps_json_num(j, "side_wall_rate", f->side_wall_rate);
+        mps_json_num(j, "side_wall_inertia", f->side_wall_inertia);
+    }
     mps_json_str(j, "ppe_solver", fluid_linsolve_method(f->ls));
     double total = mps_timer_total(&f->timer);
     mps_json_num(j, "step_seconds", total);

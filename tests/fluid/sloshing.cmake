@@ -23,7 +23,9 @@ add_test(NAME fluid_sloshing_period
 # fluid_sloshing_side_walls: the same tank with fluid.side_walls (a breadth of
 # 39 mm, the experiment's), to 2.6 s: its first mode decays faster than the
 # run above by the Stokes layers' c / 2 = sqrt(2 nu omega) / (2 B), within
-# 25% (tests/fluid/check_side_walls.py says why).
+# 25%, its period is longer by the layers' inertia, sqrt(1 + delta / B),
+# within 3%, and its bottom pressure is the same within 2%
+# (tests/fluid/check_side_walls.py says why).
 add_test(NAME fluid_sloshing_side_walls
   COMMAND ${FV_RUN} ${FV_OUT}/sloshing_side_walls ${FV_DIR}/check_side_walls.py
           --ref ${FV_OUT}/sloshing_free --breadth 0.039

@@ -785,46 +785,76 @@ static void test_guard_log(void)
 }
 
 /* fluid.side_walls: the rate is Stokes' in-phase shear over the breadth,
- * sqrt(2 nu omega) / B, and the prediction divides v + dt (visc + acc) by
- * 1 + c dt, all of it and nothing else. Two dam breaks stepped alike for a
- * step (the drag held off in one), then one step with it: every fluid
- * particle's v* is the other's times 1 / (1 + c dt). B is made small (5 mm)
- * so that the factor, 0.9985, stands well out of the rounding. */
-static void test_side_walls(void)
+ * c = sqrt(2 nu omega) / B, the inertia its reactive half, m = delta / B with
+ * delta = sqrt(2 nu / omega), and the prediction solves
+ * (1 + m) (v* - v) / dt = visc + acc - c v*, all of it and nothing else. Two
+ * dam breaks stepped alike for a step (the walls held off in one), then one
+ * step with them: every fluid particle's v* is (m v + v*_none) / (1 + m + c dt),
+ * v*_none the other's. B is made small (5 mm) so that the factors stand well
+ * out of the rounding. The drag alone (inertia = false) divides by 1 + c dt. */
+static void side_walls_case(int inertia)
 {
     const char *base[] = {"dp=0.02", "fluid.nu=5e-5"};
     const char *walls[] = {"dp=0.02", "fluid.nu=5e-5", "fluid.side_walls.breadth=0.005",
-                           "fluid.side_walls.period=1.6466"};
+                           "fluid.side_walls.period=1.6466",
+                           inertia ? "fluid.side_walls.inertia=true"
+                                   : "fluid.side_walls.inertia=false"};
     struct fluid *f0 = make("cases/dambreak/case.yml", base, 2);
-    struct fluid *f1 = make("cases/dambreak/case.yml", walls, 4);
+    struct fluid *f1 = make("cases/dambreak/case.yml", walls, 5);
     CHECK(f0 && f1);
     if (!f0 || !f1)
         return;
-    const double two_pi = 6.283185307179586;
-    const double want = sqrt(2.0 * 5e-5 * two_pi / 1.6466) / 0.005;
-    printf("side walls: rate %.6f 1/s (Stokes sqrt(2 nu omega) / B: %.6f)\n", f1->side_wall_rate,
-           want);
+    const double two_pi = 6.283185307179586, omega = two_pi / 1.6466;
+    const double want = sqrt(2.0 * 5e-5 * omega) / 0.005;
+    const double want_m = inertia ? sqrt(2.0 * 5e-5 / omega) / 0.005 : 0.0;
+    printf("side walls (inertia %d): rate %.6f 1/s (Stokes sqrt(2 nu omega) / B: %.6f), "
+           "inertia %.6f (delta / B: %.6f)\n", inertia, f1->side_wall_rate, want,
+           f1->side_wall_inertia, want_m);
     CHECK_NEAR(f1->side_wall_rate, want, 1e-12 * want);
-    CHECK(f0->side_wall_rate == 0.0);
-    const double rate = f1->side_wall_rate, dt = 1e-3;
+    CHECK_NEAR(f1->side_wall_inertia, want_m, 1e-12 * want_m);
+    CHECK_NEAR(f1->rho_inertial, f1->prm.rho * (1.0 + want_m), 1e-12 * f1->prm.rho);
+    CHECK(f0->side_wall_rate == 0.0 && f0->side_wall_inertia == 0.0);
+    CHECK(f0->rho_inertial == f0->prm.rho);
+    const double rate = f1->side_wall_rate, m = f1->side_wall_inertia, dt = 1e-3;
     f1->side_wall_rate = 0.0;
+    f1->side_wall_inertia = 0.0;
+    f1->rho_inertial = f1->prm.rho;
     CHECK(step(f0, dt) == MPS_OK && step(f1, dt) == MPS_OK);
     f1->side_wall_rate = rate;
+    f1->side_wall_inertia = m;
+    f1->rho_inertial = f1->prm.rho * (1.0 + m);
+    size_t nf = f0->nfluid;
+    double(*v0)[MPS_DIM] = malloc(nf * sizeof *v0);
+    CHECK(v0 != NULL && f1->nfluid == nf);
+    if (!v0 || f1->nfluid != nf) {
+        free(v0);
+        return;
+    }
+    memcpy(v0, f0->v, nf * sizeof *v0);
     CHECK(step(f0, dt) == MPS_OK && step(f1, dt) == MPS_OK);
-    const double keep = 1.0 / (1.0 + dt * rate);
-    double worst = 0.0, vmax = 0.0;
-    CHECK(f0->nfluid == f1->nfluid);
-    for (size_t i = 0; i < f0->nfluid && i < f1->nfluid; i++)
+    const double keep = 1.0 / (1.0 + m + dt * rate);
+    double worst = 0.0, vmax = 0.0, dmax = 0.0;
+    for (size_t i = 0; i < nf; i++)
         for (int d = 0; d < MPS_DIM; d++) {
-            worst = fmax(worst, fabs(f1->vstar[i][d] - keep * f0->vstar[i][d]));
+            double expect = (m * v0[i][d] + f0->vstar[i][d]) * keep;
+            worst = fmax(worst, fabs(f1->vstar[i][d] - expect));
             vmax = fmax(vmax, fabs(f0->vstar[i][d]));
+            dmax = fmax(dmax, fabs(expect - f0->vstar[i][d]));
         }
-    printf("side walls: |v*(walls) - v*(none) / (1 + c dt)| <= %.3g m/s (v* up to %.3g m/s, "
-           "the drag takes %.3g)\n", worst, vmax, (1.0 - keep) * vmax);
+    printf("side walls (inertia %d): |v*(walls) - (m v + v*(none)) / (1 + m + c dt)| <= %.3g m/s "
+           "(v* up to %.3g m/s, the walls change it by up to %.3g)\n", inertia, worst, vmax, dmax);
     CHECK(vmax > 0.01);
+    CHECK(dmax > 1e-3 * vmax);
     CHECK(worst <= 1e-12 * vmax);
+    free(v0);
     fluid_destroy(&f0);
     fluid_destroy(&f1);
+}
+
+static void test_side_walls(void)
+{
+    side_walls_case(1);
+    side_walls_case(0);
 }
 
 int main(int argc, char **argv)
