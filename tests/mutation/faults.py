@@ -149,7 +149,7 @@ FAULTS = [
       old='const double div_coef = f->rho_inertial / dt;',
       new='const double div_coef = p->rho / dt;',
       what='the pressure\'s divergence source at rho, without the side walls\' inertia',
-      hint='fluid_sloshing_side_walls'),
+      hint='test_fluid_step'),
     F(id='side_wall_projection_rho', eq='fluid.side_walls (Stokes layer)', file='fluid_solver/fluid.c',
       old='const double c = dt / f->rho_inertial;',
       new='const double c = dt / p->rho;',
