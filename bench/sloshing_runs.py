@@ -112,7 +112,7 @@ def do_run(name, spec, out, force, extra, coupler=COUPLER):
     subprocess.run(cmd)
 
 
-def cycles(t, x, lo, hi, band=1.0):
+def cycles(t, x, lo, hi, band=1.0, smooth=0.0):
     """Cycles of x between up-crossings of its mean over [lo, hi]: list of
     (t_start, t_end, max, min). An up-crossing counts only after x has been
     below the mean by band x its standard deviation since the last one: a
@@ -122,12 +122,25 @@ def cycles(t, x, lo, hi, band=1.0):
     standard deviation, the first choice, let a ripple of the low filling's
     2 mm refined plate through (2026-12-03: three "cycles" of 1.11 s where
     there are two of 1.67); one is still clear of the sinusoid's trough, and
-    reads every other run of this page as before."""
+    reads every other run of this page as before.
+    smooth (s, 0 = off): the crossings are found on x's running mean over
+    that time, the crests and troughs still read from x itself. The low
+    filling's 2 mm plate with the side walls' inertia (2026-12-03) jitters by
+    0.2-0.4 cm in spikes of about 0.1 s on a 1.3 cm swing, deep enough to
+    arm and cross the mean inside a half cycle: four "cycles" of 0.83 s.
+    analyse() passes a quarter of the experiment's period, which a ripple of
+    0.1 s does not survive and a swing of 1.2-1.7 s does (its crossings move
+    by nothing: a centred mean of a sinusoid crosses where it does)."""
     m = (t >= lo) & (t <= hi)
     tt, xx = t[m], x[m]
     if len(tt) < 3:
         return []
-    s = xx - xx.mean()
+    if smooth > 0.0:
+        w = max(1, int(round(smooth / float(np.median(np.diff(t))))))
+        xs = np.convolve(x, np.ones(w) / w, mode='same')[m]
+    else:
+        xs = xx
+    s = xs - xs.mean()
     h = band * float(s.std())
     up, armed = [], False
     for k in range(len(s) - 1):
@@ -188,7 +201,7 @@ def analyse(name, spec, out):
         t[-1] > 6.0 else float('nan')
     ex = EXP[case]
     lo, hi = ex['window']
-    cyc = cycles(t, x, lo, min(hi, t[-1]))
+    cyc = cycles(t, x, lo, min(hi, t[-1]), smooth=ex['period'] / 4)
     res['window'] = (lo, min(hi, float(t[-1])))
     res['ncycles'] = len(cyc)
     if cyc:
@@ -292,7 +305,7 @@ def table_vs_sinusoid(rows, out, window=None):
         got = {}
         for q in (r, s):
             p = probes(os.path.join(out, q['name'], 'probes.csv'))
-            cyc = cycles(p['time'], p['tip_dx'], lo, hi)
+            cyc = cycles(p['time'], p['tip_dx'], lo, hi, smooth=EXP[r['case']]['period'] / 4)
             if not cyc:
                 break
             got[q['motion']] = (float(np.mean([c[2] - c[3] for c in cyc])),
