@@ -399,7 +399,7 @@ static void test_ppe_terms(void)
     /* fluid.side_walls' inertia: the mixed source (Eq. 23's density term and
      * the divergence of v*) is the pressure that accelerates rho (1 + m), so
      * every row's right side scales with rho_inertial (no ghost rows with
-     * the paper's walls); the matrix does not */
+     * the paper's walls), as does alpha's term on the diagonal */
     f->prm.mixed_source = 1;
     for (size_t i = 0; i < f->ps.n; i++) /* a divergence of v* to scale: the steps */
         f->div[i] = 10.0 * sin((double)i);  /* above solved the density source only */
