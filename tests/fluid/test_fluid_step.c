@@ -856,6 +856,8 @@ static void side_walls_case(int inertia)
     CHECK(v0 != NULL && f1->nfluid == nf);
     if (!v0 || f1->nfluid != nf) {
         free(v0);
+        fluid_destroy(&f0);
+        fluid_destroy(&f1);
         return;
     }
     memcpy(v0, f0->v, nf * sizeof *v0);
