@@ -111,6 +111,13 @@ const struct mps_key_spec fluid_case_keys[] = {
      "inertia of delta / breadth (delta = sqrt(2 nu / omega)) on the flow and its pressure "
      "correction, which lowers the sloshing frequency by about the damping ratio; false: "
      "the drag alone"},
+    {"fluid.jitter.amplitude", MPS_KEY_DOUBLE, "0", 0, 0.1, 0, NULL, "dp",
+     "displace each fluid particle's starting position by a uniform random amount of at "
+     "most this in x and in y: one realisation of an ensemble, for a flow whose details "
+     "after an impact are chaotic (the peak of an impact pressure: docs/pressure.md, "
+     "\"Impact pressure\"); 0 (default): the lattice"},
+    {"fluid.jitter.seed", MPS_KEY_INT, "1", 0, 0, NOHI, NULL, "",
+     "the realisation: the same seed gives the same positions, whatever the thread count"},
     {"fluid.shifting", MPS_KEY_DOUBLE, "2.0", 0, 0, NOHI, NULL, "",
      "particle shifting coefficient A of dr = -A dp |v| dt grad n / n0 (0: off)"},
     {"fluid.shifting_max", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "dp",
@@ -339,6 +346,8 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
                              "viscous");
     p->shift_coef = mps_case_double(c, "fluid.shifting");
     p->shift_max = mps_case_double(c, "fluid.shifting_max");
+    p->jitter = mps_case_double(c, "fluid.jitter.amplitude");
+    p->jitter_seed = (unsigned long)mps_case_int(c, "fluid.jitter.seed");
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");
     p->step_log = mps_case_bool(c, "fluid.step_log");
     p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");

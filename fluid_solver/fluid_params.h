@@ -85,6 +85,8 @@ struct fluid_params {
     double side_wall_period;      /* s: their boundary layers' period; 0 = the motion's */
     int side_wall_inertia;        /* the layers' reactive half too (an inertia), not the drag only */
     double shift_coef, shift_max; /* particle shifting: A (0 = off), cap in dp */
+    double jitter;                /* dp: largest start displacement per axis; 0 = lattice */
+    unsigned long jitter_seed;    /* which realisation of the jitter */
     const char *ppe_solver;
     int step_log;                 /* write PREFIX_steps.csv */
     double ppe_rtol;

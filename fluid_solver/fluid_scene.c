@@ -24,6 +24,19 @@ static int push(struct pts_buf *b, double x, double y, int type)
     return 0;
 }
 
+/* splitmix64 of (seed, particle, axis): a uniform number in [-1, 1) that
+ * depends on nothing else, so a realisation is the same whatever the order or
+ * thread count that builds it. */
+static double jitter_unit(unsigned long seed, size_t k, int axis)
+{
+    unsigned long long z = (unsigned long long)seed * 0x9E3779B97F4A7C15ULL +
+                           (2ULL * k + (unsigned long long)axis + 1ULL) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ULL;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBULL;
+    z ^= z >> 31;
+    return (double)(z >> 11) * 0x1.0p-52 - 1.0;
+}
+
 /* Number of lattice points with centres at lo + (i + 1/2) dp inside [lo, hi);
  * a tolerance absorbs decimal round-off (0.584 / 0.004 must give 146). */
 static long lattice_count(double lo, double hi, double dp)
@@ -77,6 +90,9 @@ int fluid_scene_build(const struct fluid_params *p, struct fluid_scene_pt **pts,
                     goto fail;
     }
     size_t nf = b.n;
+    for (size_t k = 0; p->jitter > 0.0 && k < nf; k++)
+        for (int d = 0; d < MPS_DIM; d++)
+            b.a[k].x[d] += p->jitter * dp * jitter_unit(p->jitter_seed, k, d);
 
     /* Side walls run from the bottom of the dummy layers to the top of the
      * wall (or of the lid's layers); the floor (and lid) span the inner width,

@@ -17,7 +17,9 @@
  *   - the tank's walls close every corner when its width (or a lid's
  *     height) is not a whole number of spacings (fluid_scene.c);
  *   - the tank guard logs its use per face and its first use, and the
- *     rollback image keeps that log. */
+ *     rollback image keeps that log;
+ *   - fluid.jitter displaces the starting lattice within its amplitude, the
+ *     same for a seed, and leaves the walls. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -777,6 +779,76 @@ static void test_tank_corners(void)
     }
 }
 
+/* fluid.jitter: every fluid particle within a dp of its lattice point per
+ * axis, spread uniformly (mean 0, standard deviation a dp / sqrt 3), the same
+ * for the same seed and another for another seed; the walls stay where they
+ * are; the keys reach the fluid. */
+static void test_jitter(void)
+{
+    struct fluid_params p;
+    memset(&p, 0, sizeof p);
+    p.dp = 0.004;
+    p.tank_w = 0.584;
+    p.tank_h = 0.584;
+    p.wall_layers = 3;
+    p.nblocks = 1;
+    p.block[0][2] = 0.146;
+    p.block[0][3] = 0.292;
+    struct fluid_scene_pt *pt[4] = {NULL};
+    size_t nf[4], nw[4];
+    const double a = 0.01;
+    const unsigned long seed[4] = {0, 3, 3, 4};
+    for (int r = 0; r < 4; r++) {
+        p.jitter = r ? a : 0.0;
+        p.jitter_seed = seed[r];
+        CHECK(fluid_scene_build(&p, &pt[r], &nf[r], &nw[r]) == 0);
+    }
+    if (pt[0] && pt[1] && pt[2] && pt[3]) {
+        CHECK(nf[1] == nf[0] && nw[1] == nw[0] && nf[0] == 36 * 73);
+        double worst = 0.0, sum = 0.0, sum2 = 0.0;
+        size_t differ = 0, moved_walls = 0;
+        for (size_t i = 0; i < nf[0]; i++)
+            for (int d = 0; d < MPS_DIM; d++) {
+                double e = (pt[1][i].x[d] - pt[0][i].x[d]) / p.dp;
+                worst = fmax(worst, fabs(e));
+                sum += e;
+                sum2 += e * e;
+                CHECK(pt[2][i].x[d] == pt[1][i].x[d]);
+                differ += pt[3][i].x[d] != pt[1][i].x[d];
+            }
+        for (size_t i = nf[0]; i < nf[0] + nw[0]; i++)
+            for (int d = 0; d < MPS_DIM; d++)
+                moved_walls += pt[1][i].x[d] != pt[0][i].x[d];
+        const double m = 2.0 * nf[0], mean = sum / m, sd = sqrt(sum2 / m - mean * mean);
+        printf("jitter %g dp over %zu particles: largest %.5f dp, mean %.2e dp, sd %.5f dp "
+               "(uniform: %.5f); another seed moves %zu of %.0f coordinates\n", a, nf[0], worst,
+               mean, sd, a / sqrt(3.0), differ, m);
+        CHECK(worst <= a && worst > 0.99 * a);
+        /* 5256 draws: the mean's standard error is 0.008 a, the sd's 0.01 a */
+        CHECK(fabs(mean) < 0.04 * a);
+        CHECK_NEAR(sd, a / sqrt(3.0), 0.05 * a / sqrt(3.0));
+        CHECK(differ == (size_t)m);
+        CHECK(moved_walls == 0);
+    }
+    for (int r = 0; r < 4; r++)
+        free(pt[r]);
+
+    const char *sets[] = {"dp=0.008", "fluid.jitter.amplitude=0.05", "fluid.jitter.seed=7"};
+    struct fluid *f0 = make("cases/dambreak/case.yml", sets, 1);
+    struct fluid *f1 = make("cases/dambreak/case.yml", sets, 3);
+    CHECK(f0 && f1);
+    if (f0 && f1) {
+        double worst = 0.0;
+        for (size_t i = 0; i < f0->nfluid; i++)
+            for (int d = 0; d < MPS_DIM; d++)
+                worst = fmax(worst, fabs(f1->x[i][d] - f0->x[i][d]) / 0.008);
+        printf("the case's keys: largest start displacement %.4f dp (amplitude 0.05)\n", worst);
+        CHECK(worst > 0.045 && worst <= 0.05);
+    }
+    fluid_destroy(&f0);
+    fluid_destroy(&f1);
+}
+
 /* A particle pushed under the floor must be put back, counted on the floor
  * with the step's time and where it was; a rollback restores the log. */
 static void test_guard_log(void)
@@ -909,5 +981,6 @@ int main(int argc, char **argv)
     test_tank_corners();
     test_guard_log();
     test_side_walls();
+    test_jitter();
     return test_summary("test_fluid_step");
 }
