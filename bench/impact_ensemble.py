@@ -4,7 +4,7 @@
 
 usage: bench/impact_ensemble.py [--dps 0.008:16,0.004:12,0.002:6] [--jitter 0.001]
                                 [--end 0.32] [--jobs 1] [--threads 1] [--out DIR]
-                                [--table FILE] [--plot FILE] [--set KEY=VALUE ...]
+                                [--table FILE] [--plot FILE] [--json FILE] [--set KEY=VALUE ...]
 
 After the front hits the wall the flow is chaotic: a single run's peak pressure
 is one draw, and the thread count alone (the sums' rounding) moves it by
@@ -85,6 +85,7 @@ def main():
     ap.add_argument('--out', default=None)
     ap.add_argument('--table', default=None)
     ap.add_argument('--plot', default=None)
+    ap.add_argument('--json', default=None, help='every run\'s metrics and the ensembles\' means')
     ap.add_argument('--reuse', action='store_true')
     ap.add_argument('--set', action='append', default=[], metavar='KEY=VALUE')
     a = ap.parse_args()
@@ -107,7 +108,7 @@ def main():
                  a.jitter, a.threads, a.end, ''.join(', --set ' + s for s in a.set)), '',
              '| dp (mm) | N | ' + ' | '.join(k[1] for k in KEYS) + ' | steps | wall s per run |',
              '|---|---|' + '---|' * len(KEYS) + '---|---|']
-    means = {}
+    means, record = {}, {'jitter': a.jitter, 'threads': a.threads, 'end': a.end, 'sets': a.set, 'dps': {}}
     for dp, n in plan:
         ms, steps, wall = [], [], []
         for s in range(1, n + 1):
@@ -121,6 +122,8 @@ def main():
         for key, _, scale, fmt in KEYS:
             m, sd, se, k = stats([scale * x[key] for x in ms if x])
             means[(dp, key)] = (m, se)
+            record['dps'].setdefault(dp, {'runs': [runs[(dp, s)] for s in range(1, n + 1)],
+                                          'metrics': ms})[key] = {'mean': m, 'sd': sd, 'se': se}
             cells.append((fmt + ' +- ' + fmt + ' (' + fmt + ')') % (m, se, sd))
         lines.append('| %g | %d | %s | %.0f | %.1f |' % (1000 * float(dp), n, ' | '.join(cells),
                                                          np.mean(steps), np.mean(wall)))
@@ -145,6 +148,9 @@ def main():
     if a.table:
         with open(a.table, 'w') as f:
             f.write(table)
+    if a.json:
+        with open(a.json, 'w') as f:
+            json.dump(record, f, indent=1)
 
     if a.plot:
         import matplotlib

@@ -107,13 +107,19 @@ def dambreak(a):
           f'rho U^2/2 = {0.01 * p_stag:.0f} Pa or {0.01 * p_stag * COLUMN_H:.1f} N/m)')
     # The rise: the first row at half the stagnation pressure. The water must
     # pile up at the wall to the sensor's face (12-20 mm) at about the front
-    # speed, 8 ms at 2.5 m/s, and a row is a mean over its interval (2 ms):
-    # within 10 ms of the arrival, and not before it (2 ms: one interval).
+    # speed, 8 ms at 2.5 m/s, and a row is a mean over its interval (2 ms),
+    # and not before the arrival (2 ms: one interval). That is the typical
+    # case, not the bound: 16 realisations of the 8 mm run (jittered starts,
+    # bench/impact_ensemble.py, 2026-12-03) rose at -2 to +10 ms in 14 and at
+    # +16.6 and +20.5 ms in two, where the front's tongue was thinner than
+    # the sensor's height and the thicker water behind it had to arrive
+    # (the 8 mm sensor is one particle across). So the band is -2..+25 ms:
+    # the impact when the front arrives, not the run-up's return 0.15 s later.
     rise = [r for r in rows if r[p] >= 0.5 * p_stag]
     t_r = rise[0]['time'] if rise else math.inf
-    check(t_a - 0.002 <= t_r <= t_a + 0.010,
+    check(t_a - 0.002 <= t_r <= t_a + 0.025,
           f'{p} rises (>= {0.5 * p_stag:.0f} Pa) at t = {t_r:.4f} s, {1e3 * (t_r - t_a):+.1f} ms '
-          f'from the arrival (band -2..+10 ms)')
+          f'from the arrival (band -2..+25 ms)')
     # The impact: within 30 ms of the arrival the sensor's peak is at least
     # the stagnation pressure of the arriving stream (a wall that stops a
     # stream feels that at its stagnation point; an impact adds to it), and

@@ -5,7 +5,10 @@
 #                              water (bands in tests/fluid/check_sensors.py);
 #   fluid_sensors_dambreak     cases/dambreak, dp = 8 mm, 0.35 s: the
 #                              right-wall sensor sees the impact when the
-#                              front arrives, and its rows are time means.
+#                              front arrives, and its rows are time means;
+#   fluid_impact_ensemble      the same impact in four realisations (jittered
+#                              starts, bench/impact_ensemble.py): each one
+#                              physical, the four distinct.
 set(FS_DIR ${CMAKE_CURRENT_LIST_DIR})
 set(FS_OUT ${CMAKE_BINARY_DIR}/test_out/fluid_sensors)
 add_test(NAME fluid_sensors_hydrostatic
@@ -18,5 +21,8 @@ add_test(NAME fluid_sensors_dambreak
   COMMAND sh ${FS_DIR}/scripts/sensors_dambreak.sh ${CMAKE_BINARY_DIR}/bin/fluid_solver
           ${FS_OUT}/dambreak
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(fluid_sensors_hydrostatic fluid_sensors_dambreak
+add_test(NAME fluid_impact_ensemble
+  COMMAND sh ${FS_DIR}/scripts/impact_ensemble.sh ${CMAKE_BINARY_DIR} ${FS_OUT}/ensemble
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_sensors_hydrostatic fluid_sensors_dambreak fluid_impact_ensemble
   PROPERTIES LABELS validation TIMEOUT 120 ENVIRONMENT "OMP_NUM_THREADS=1")
