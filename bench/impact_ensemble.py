@@ -135,13 +135,14 @@ def main():
             (m1, e1), (m2, e2) = means[(dps[j], key)], means[(dps[j + 1], key)]
             parts.append((fmt + ' +- ' + fmt) % (m1 - m2, math.hypot(e1, e2)))
         text = '%s: successive differences %s' % (name, ', '.join(parts))
-        if len(dps) >= 3:
-            q = [means[(dp, key)][0] for dp in dps[:3]]
+        orders = []
+        for j in range(len(dps) - 2):
+            q = [means[(dp, key)][0] for dp in dps[j:j + 3]]
             d1, d2 = q[0] - q[1], q[1] - q[2]
-            if d1 and d2 and (d1 > 0) == (d2 > 0):
-                text += ': observed order %.2f' % math.log2(abs(d1) / abs(d2))
-            else:
-                text += ': no order (the differences change sign)'
+            orders.append('%.2f' % math.log2(abs(d1) / abs(d2)) if d1 and d2 and (d1 > 0) == (d2 > 0)
+                          else 'none (the sign changes)')
+        if orders:
+            text += ': observed order %s' % ', '.join(orders)
         lines.append(text + '  ')
     # The peak of the ensemble's mean signal: the mean of the peaks above is
     # biased up by each run's noise (the largest of noisy rows); the mean
