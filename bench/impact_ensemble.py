@@ -29,14 +29,14 @@ error (both means' errors combined).
           are seeds, so one thread count for all);
 --reuse   keep the runs already in OUT (their summary.json says ok).
 """
-import argparse, concurrent.futures, json, math, os, subprocess, sys, tempfile
+import argparse, concurrent.futures, json, math, os, sys, tempfile
 
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
-from pressure_quality import impact_metrics, probes  # noqa: E402  (one definition)
+from pressure_quality import impact_metrics, probes, run  # noqa: E402  (one definition)
 
 KEYS = (('t_arrive', 'arrival (s)', 1.0, '%.4f'),
         ('peak', 'peak of the 2 ms rows (Pa)', 1.0, '%.0f'),
@@ -53,25 +53,27 @@ def one_run(a, dp, seed):
         with open(summ) as f:
             if json.load(f).get('status') == 'ok':
                 return out
-    cmd = [os.path.join(a.build, 'bin', 'fluid_solver'), os.path.join(ROOT, 'cases/dambreak/case.yml'),
-           '--out', out, '--quiet', '--set', 'dp=%s' % dp, '--set', 'end_time=%g' % a.end,
-           '--set', 'output.interval=0', '--set', 'fluid.jitter.amplitude=%g' % a.jitter,
-           '--set', 'fluid.jitter.seed=%d' % seed]
-    for kv in a.set:
-        cmd += ['--set', kv]
-    env = dict(os.environ, OMP_NUM_THREADS=str(a.threads))
-    r = subprocess.run(cmd, env=env, cwd=ROOT, stderr=subprocess.PIPE, text=True)
-    if r.returncode != 0 or not os.path.exists(summ):
-        raise SystemExit('%s failed (exit %d): %s' % (' '.join(cmd), r.returncode, r.stderr[-400:]))
+    run(os.path.join(a.build, 'bin', 'fluid_solver'), 'cases/dambreak/case.yml', out,
+        ['dp=%s' % dp, 'end_time=%g' % a.end, 'output.interval=0', 'fluid.jitter.amplitude=%g' % a.jitter,
+         'fluid.jitter.seed=%d' % seed] + a.set, env={'OMP_NUM_THREADS': str(a.threads)})
     return out
+
+
+def signals(runs, dp, n):
+    """The n realisations' p_wall rows side by side (rows k of all runs are
+    the first steps past the same probe time) and their mean times."""
+    sig = [probes(runs[(dp, s)]) for s in range(1, n + 1)]
+    k = min(len(p['time']) for p in sig)
+    return (np.mean([p['time'][:k] for p in sig], axis=0),
+            np.array([p['p_wall'][:k] for p in sig]))
 
 
 def stats(vals):
     v = np.array([x for x in vals if np.isfinite(x)])
     if len(v) < 2:
-        return float(v.mean()) if len(v) else float('nan'), float('nan'), float('nan'), len(v)
+        return float(v.mean()) if len(v) else float('nan'), float('nan'), float('nan')
     sd = float(v.std(ddof=1))
-    return float(v.mean()), sd, sd / math.sqrt(len(v)), len(v)
+    return float(v.mean()), sd, sd / math.sqrt(len(v))
 
 
 def main():
@@ -120,7 +122,7 @@ def main():
             wall.append(summ['wall_seconds'])
         cells = []
         for key, _, scale, fmt in KEYS:
-            m, sd, se, k = stats([scale * x[key] for x in ms if x])
+            m, sd, se = stats([scale * x[key] for x in ms if x])
             means[(dp, key)] = (m, se)
             record['dps'].setdefault(dp, {'runs': [runs[(dp, s)] for s in range(1, n + 1)],
                                           'metrics': ms})[key] = {'mean': m, 'sd': sd, 'se': se}
@@ -152,10 +154,7 @@ def main():
     rng = np.random.default_rng(12345)
     peaks_of_mean = []
     for dp, n in plan:
-        sig = [probes(runs[(dp, s)]) for s in range(1, n + 1)]
-        k = min(len(p['time']) for p in sig)
-        t = np.mean([p['time'][:k] for p in sig], axis=0)
-        v = np.array([p['p_wall'][:k] for p in sig])
+        t, v = signals(runs, dp, n)
         j = int(np.argmax(v.mean(axis=0)))
         boot = [v[rng.integers(0, n, n)].mean(axis=0).max() for _ in range(400)]
         peaks_of_mean.append(float(v.mean(axis=0)[j]))
@@ -180,12 +179,9 @@ def main():
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots(figsize=(7, 4))
         for dp, n in plan:
-            sig = [probes(runs[(dp, s)]) for s in range(1, n + 1)]
-            t = sig[0]['time']
-            k = min(len(p['time']) for p in sig)
-            v = np.array([p['p_wall'][:k] for p in sig])
-            line, = ax.plot(t[:k], v.mean(axis=0), lw=1.0, label='dp = %g mm (mean of %d)' % (1000 * float(dp), n))
-            ax.fill_between(t[:k], v.mean(axis=0) - v.std(axis=0), v.mean(axis=0) + v.std(axis=0),
+            t, v = signals(runs, dp, n)
+            line, = ax.plot(t, v.mean(axis=0), lw=1.0, label='dp = %g mm (mean of %d)' % (1000 * float(dp), n))
+            ax.fill_between(t, v.mean(axis=0) - v.std(axis=0), v.mean(axis=0) + v.std(axis=0),
                             color=line.get_color(), alpha=0.2, lw=0)
         ax.set_xlim(0.24, a.end)
         ax.set_xlabel('t (s)')
