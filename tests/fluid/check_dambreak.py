@@ -1,12 +1,16 @@
 #!/usr/bin/python3
 """Checks a dam-break run (cases/dambreak) against Martin & Moyce (1952).
 
-usage: check_dambreak.py RUN_DIR [--tmax 3] [--max-front-err 0.25]
+usage: check_dambreak.py RUN_DIR [RUN_DIR...] [--tmax 3] [--max-front-err 0.25]
                          [--mean-front-err 0.15] [--speed-err 0.10]
                          [--speed-err-high E]
                          [--max-height-err 0.18] [--mean-height-err 0.10]
                          [--shift DT --shifted-max-err E --shifted-mean-err E]
 Uses bench/dambreak_compare.py (reference: cases/dambreak/martin_moyce.csv).
+With several RUN_DIRs (the realisations of an ensemble: jittered starts,
+tests/fluid/scripts/dambreak_ensemble.sh) each one's errors are printed with
+their mean, standard deviation and standard error, and the bands hold the
+means: one run's measures are one draw from a spread of several points.
   - the run reached T = tmax;
   - front Z(T): max and mean relative error over the table points up to tmax;
   - front speed: the least-squares slope dZ/dT over the table points with
@@ -39,9 +43,48 @@ def slope(pts):
     return sum((p[0] - mx) * (p[1] - my) for p in pts) / sxx
 
 
+def measures(run, a):
+    """The run's errors against the measurements (relative): front max and
+    mean |err|, front speed, height max and mean |err|, and with a.shift the
+    shifted front's max and mean |err|; None if it has no comparison points."""
+    r = dc.compare(run, a.a, a.tmax)
+    if not r['front'] or not r['height']:
+        return None
+    late = [(T, Z, z) for T, Z, z, _ in r['front'] if T >= 1.4]
+    s_exp = slope([(T, Z) for T, Z, _ in late])
+    s_sim = slope([(T, z) for T, _, z in late])
+    m = {'front': r['front'], 'npts': len(r['front']), 'nheight': len(r['height']),
+         'front_max': r['front_max_rel_err'], 'front_mean': r['front_mean_rel_err'],
+         'speed': s_sim / s_exp - 1.0, 's_exp': s_exp, 's_sim': s_sim,
+         'height_max': r['height_max_rel_err'], 'height_mean': r['height_mean_rel_err']}
+    if a.shift is not None:
+        smax, smean, m['shift_ms'] = shifted(run, a, a.shift)
+        m['shifted_max'], m['shifted_mean'] = abs(smax), smean
+    return m
+
+
+def shifted(run, a, dT):
+    """Front errors against the measurements dT later in T: max (signed),
+    mean |err|, dT in ms."""
+    pr = dc.load_probes(run)
+    s = math.sqrt(2 * 9.81 / a.a)
+    errs = []
+    for T, Z in dc.load_ref()['mm_table_T_Z']:
+        if T > a.tmax:
+            continue
+        x = dc.interp(pr['time'], pr['front'], (T - dT) / s)
+        errs.append(((x if x is not None else pr['front'][0]) / a.a - Z) / Z)
+    return max(errs, key=abs), sum(map(abs, errs)) / len(errs), 1000 * dT / s
+
+
+KEYS = ['front_max', 'front_mean', 'speed', 'height_max', 'height_mean', 'shifted_max',
+        'shifted_mean']
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument('run')
+    ap.add_argument('run', nargs='+', help='one run, or the realisations of an ensemble '
+                    '(the bands then hold their means)')
     ap.add_argument('--a', type=float, default=0.146)
     ap.add_argument('--tmax', type=float, default=3.0)
     ap.add_argument('--max-front-err', type=float, default=0.25)
@@ -59,30 +102,49 @@ def main():
                     help='also print the front error against the measurements shifted by '
                          'dT = 0.1 ... 0.3 (a late release in the experiment), no check')
     a = ap.parse_args()
-    r = dc.compare(a.run, a.a, a.tmax)
     bad = []
     npts = sum(1 for T, _ in dc.load_ref()['mm_table_T_Z'] if T <= a.tmax)
-    if len(r['front']) < npts:
-        bad.append(f"the run covers {len(r['front'])} of the {npts} front points up to "
-                   f"T = {a.tmax}")
-    if not r['front'] or not r['height']:
-        print('FAIL: no comparison points')
-        sys.exit(1)
-    for T, Z, z, e in r['front']:
-        print(f'  T {T:5.2f}  Z measured {Z:5.2f}  simulated {z:5.2f}  {100 * e:+6.1f}%')
-    fmax, fmean = r['front_max_rel_err'], r['front_mean_rel_err']
-    late = [(T, Z, z) for T, Z, z, _ in r['front'] if T >= 1.4]
-    s_exp = slope([(T, Z) for T, Z, _ in late])
-    s_sim = slope([(T, z) for T, _, z in late])
-    s_err = s_sim / s_exp - 1.0
-    hmax, hmean = r['height_max_rel_err'], r['height_mean_rel_err']
+    ms = []
+    for run in a.run:
+        m = measures(run, a)
+        if m is None:
+            print(f'FAIL: {run}: no comparison points')
+            sys.exit(1)
+        if m['npts'] < npts:
+            bad.append(f"{run} covers {m['npts']} of the {npts} front points up to "
+                       f"T = {a.tmax}")
+        ms.append(m)
+    keys = [k for k in KEYS if k in ms[0]]
+    if len(ms) == 1:
+        for T, Z, z, e in ms[0]['front']:
+            print(f'  T {T:5.2f}  Z measured {Z:5.2f}  simulated {z:5.2f}  {100 * e:+6.1f}%')
+        m = dict(ms[0])
+    else:
+        print('realisation  ' + '  '.join(f'{k:>12}' for k in keys) + '   (%)')
+        for run, m in zip(a.run, ms):
+            print(f'{os.path.basename(run.rstrip("/")):>11}  ' +
+                  '  '.join(f'{100 * m[k]:+12.1f}' for k in keys))
+        n = len(ms)
+        m = {k: sum(x[k] for x in ms) / n for k in keys}
+        sd = {k: math.sqrt(sum((x[k] - m[k]) ** 2 for x in ms) / (n - 1)) for k in keys}
+        print(f'{"mean":>11}  ' + '  '.join(f'{100 * m[k]:+12.2f}' for k in keys))
+        print(f'{"sd":>11}  ' + '  '.join(f'{100 * sd[k]:12.2f}' for k in keys))
+        print(f'{"SE":>11}  ' + '  '.join(f'{100 * sd[k] / math.sqrt(n):12.2f}' for k in keys))
+        print(f'the bands below hold the means of the {n} realisations')
+        m['s_exp'] = ms[0]['s_exp']
+        m['s_sim'] = sum(x['s_sim'] for x in ms) / n
+        m['nheight'] = ms[0]['nheight']
+        m['shift_ms'] = ms[0].get('shift_ms')
+    fmax, fmean, s_err = m['front_max'], m['front_mean'], m['speed']
+    hmax, hmean = m['height_max'], m['height_mean']
     print(f"front: max |err| {100 * fmax:.1f}% (tol {100 * a.max_front_err:.1f}%), mean "
           f"{100 * fmean:.1f}% (tol {100 * a.mean_front_err:.1f}%)")
     s_high = a.speed_err if a.speed_err_high is None else a.speed_err_high
-    print(f"front speed dZ/dT for T >= 1.4: measured {s_exp:.3f}, simulated {s_sim:.3f} "
-          f"({100 * s_err:+.1f}%, tol -{100 * a.speed_err:.1f}% / +{100 * s_high:.1f}%)")
+    print(f"front speed dZ/dT for T >= 1.4: measured {m['s_exp']:.3f}, simulated "
+          f"{m['s_sim']:.3f} ({100 * s_err:+.1f}%, tol -{100 * a.speed_err:.1f}% / "
+          f"+{100 * s_high:.1f}%)")
     print(f"height: max |err| {100 * hmax:.1f}% (tol {100 * a.max_height_err:.1f}%), mean "
-          f"{100 * hmean:.1f}% (tol {100 * a.mean_height_err:.1f}%) over {len(r['height'])} "
+          f"{100 * hmean:.1f}% (tol {100 * a.mean_height_err:.1f}%) over {m['nheight']} "
           f"points")
     if fmax > a.max_front_err or fmean > a.mean_front_err:
         bad.append('front position')
@@ -90,29 +152,19 @@ def main():
         bad.append('front speed')
     if hmax > a.max_height_err or hmean > a.mean_height_err:
         bad.append('height at the wall')
-    def shifted(dT):
-        """Front errors against the measurements dT later in T."""
-        pr = dc.load_probes(a.run)
-        s = math.sqrt(2 * 9.81 / a.a)
-        errs = []
-        for T, Z in dc.load_ref()['mm_table_T_Z']:
-            if T > a.tmax:
-                continue
-            x = dc.interp(pr['time'], pr['front'], (T - dT) / s)
-            errs.append(((x if x is not None else pr['front'][0]) / a.a - Z) / Z)
-        return max(errs, key=abs), sum(map(abs, errs)) / len(errs), 1000 * dT / s
     if a.shift is not None:
-        smax, smean, ms = shifted(a.shift)
-        print(f"front against the measurements {a.shift:.2f} later in T ({ms:.0f} ms): max "
-              f"|err| {100 * abs(smax):.1f}% (tol {100 * a.shifted_max_err:.1f}%), mean "
+        smax, smean = m['shifted_max'], m['shifted_mean']
+        print(f"front against the measurements {a.shift:.2f} later in T ({m['shift_ms']:.0f} "
+              f"ms): max |err| {100 * smax:.1f}% (tol {100 * a.shifted_max_err:.1f}%), mean "
               f"{100 * smean:.1f}% (tol {100 * a.shifted_mean_err:.1f}%)")
-        if abs(smax) > a.shifted_max_err or smean > a.shifted_mean_err:
+        if smax > a.shifted_max_err or smean > a.shifted_mean_err:
             bad.append('front against the shifted measurements')
     if a.report_shift:
         for dT in (0.1, 0.15, 0.2, 0.25, 0.3):
-            smax, smean, ms = shifted(dT)
-            print(f"measurements {dT:.2f} later in T ({ms:.0f} ms): front max "
-                  f"{100 * smax:+.1f}%, mean |.| {100 * smean:.1f}%")
+            for run in a.run:
+                smax, smean, ms_ = shifted(run, a, dT)
+                print(f"{run}: measurements {dT:.2f} later in T ({ms_:.0f} ms): front max "
+                      f"{100 * smax:+.1f}%, mean |.| {100 * smean:.1f}%")
     for b in bad:
         print('FAIL:', b)
     sys.exit(1 if bad else 0)
