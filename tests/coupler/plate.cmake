@@ -17,7 +17,11 @@
 #    thread count part by 0.4 cm RMS (1.20 and 0.80 cm), so a band there
 #    measures chance (it was 1.2 cm until the face loads put the two-thread
 #    run at 1.205);
-#  - inside the envelope at least 80% of [0, 1] s (measured 93-94%);
+#  - inside the envelope at least 70% of [0, 1] s (the lattice measured
+#    93-94%; four realisations from jittered starts, fluid.jitter 1e-3 dp,
+#    seeds 1-4, one thread, 2026-12-03: 93, 91, 81 and 91%: mean 89, sd 5.
+#    After 0.5 s the flow is chaotic and realisations part, so the band sits
+#    3.5 sd below their mean; it was 80%, one point under the third seed);
 #  - |dx| below 3.5 cm after 0.5 s, when water surrounds the plate (the
 #    references stay within 2-3 cm; with the MPS solid undamped the spin mode
 #    tore the plate at 1.05 s, 21 cm).
@@ -26,7 +30,7 @@
 # The plate's force probes (solid.probes) must agree with the coupler's
 # solid_fx, solid_fy row by row (body_load_check.py).
 add_test(NAME coupled_dambreak_plate_coarse
-         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6 --quiet --set dp=0.006 --set end_time=1.5 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 0.5 --peak-band 0.041 0.049 --peak-time 0.22 0.26 --rms-max 0.009 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 1.0 --inside-min 0.80 --max-after 0.5 0.035 && /usr/bin/python3 tests/coupler/body_load_check.py ${CMAKE_BINARY_DIR}/test_out/plate6"
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6 --quiet --set dp=0.006 --set end_time=1.5 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 0.5 --peak-band 0.041 0.049 --peak-time 0.22 0.26 --rms-max 0.009 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6 --tmax 1.0 --inside-min 0.70 --max-after 0.5 0.035 && /usr/bin/python3 tests/coupler/body_load_check.py ${CMAKE_BINARY_DIR}/test_out/plate6"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupled_dambreak_plate_coarse PROPERTIES TIMEOUT 300 LABELS validation)
 
