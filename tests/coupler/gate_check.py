@@ -4,14 +4,19 @@ to 0.2 s): the water column pushes the gate's free end open, downstream and
 up, to a first peak, after which the gate closes as the column drains.
 
 The band is the primary opening: the largest tip_dx up to 0.15 s must lie in
-3.35-3.85 cm, reached at 0.09-0.125 s. Physics: at dp = 1 mm (5 particles
+3.35-3.85 cm, reached at 0.085-0.125 s. Physics: at dp = 1 mm (5 particles
 thick, docs/elastic_gate.md) the solids peak at 3.66-4.14 cm at 0.111-0.123 s
 (MPS plane strain and quadratic TLSPH, the two consistent discretisations,
 3.66 and 3.81 cm: 4% apart); the opening is driven by the column, and both
 coarse solids, two different discretisations of the same 2-particle gate,
 peak at 3.58-3.59 cm at 0.099-0.105 s (measured 2026-12-02, the same to 0.01 cm
 with 1 and 2 threads and MPS_SIMD=sse2). The band is that value +-7%: the spread of the
-consistent fine solids plus a margin. Then, at 0.15 s, the gate is
+consistent fine solids plus a margin. The peak is flat, so the time of its maximum
+wanders: eight realisations from jittered starts (fluid.jitter 1e-3 dp, seeds 1-4, each
+solid, one thread, 2026-12-03) peak at 3.52-3.57 cm but at 0.092-0.102 s (mean 0.098,
+sd 0.004), and one variant of the fluid read 0.089 s (docs/pressure.md). The time band
+starts at 0.085 s, three standard deviations under their mean (it was 0.09, two realisations
+2 ms from it). Then, at 0.15 s, the gate is
 closing (tip_dx below its peak), the end never goes down into the floor
 (tip_dy >= -2 mm) and it swings up on its arc (tip_dy > 0 at the peak).
 
@@ -33,7 +38,7 @@ k = max(early, key=lambda i: dx[i])
 at15 = min(range(len(t)), key=lambda i: abs(t[i] - 0.15))
 checks = [
     (0.0335 <= dx[k] <= 0.0385, f"peak opening {100 * dx[k]:.2f} cm (band 3.35-3.85 cm)"),
-    (0.09 <= t[k] <= 0.125, f"at {t[k]:.3f} s (band 0.09-0.125 s)"),
+    (0.085 <= t[k] <= 0.125, f"at {t[k]:.3f} s (band 0.085-0.125 s)"),
     (dx[at15] < dx[k], f"closing at 0.15 s: {100 * dx[at15]:.2f} cm"),
     (min(dy) >= -0.002, f"tip_dy min {1000 * min(dy):.2f} mm (>= -2 mm)"),
     (dy[k] > 0, f"tip_dy at the peak {100 * dy[k]:.2f} cm (> 0)"),
