@@ -39,7 +39,8 @@ set_tests_properties(coupled_motion_refused_by_python_solid coupled_motion_refus
 # (docs/sloshing.md). The cases' own coupling is implicit since 2026-12-03:
 # run so, these tests read lags of 9.7 (low) and 55.2 degrees (high) at 2.22
 # and 1.55 iterations per step. The high filling alone on the quiet machine
-# (two threads): 90 s implicit, 54 s explicit; beside a 1 mm run and the rest
+# (two threads, this command with either scheme): 90 s implicit, 54 s
+# explicit; beside a 1 mm run and the rest
 # of the suite both implicit tests timed out at 600 s (the explicit ones took
 # 77 and 118 s in a ctest -j2 of a few tests on the quiet machine). The
 # implicit coupling has its own tests
