@@ -340,16 +340,6 @@ static enum mps_status open_endpoint(struct coupler *c, int k, struct mps_err *e
     return proto_link_open(c->zctx, PROTO_LINK_BIND, p->endpoint, &p->sock, err);
 }
 
-/* coupling.implicit.smooth (spacings) as the patch side of the convergence
- * measures (coupling_iter.h) */
-static enum mps_status smooth_patches(struct coupler *c, struct mps_err *err)
-{
-    return coupling_iter_smooth(&c->iter,
-                                mps_case_double(c->cs, "coupling.implicit.smooth") *
-                                    mps_case_double(c->cs, "dp"),
-                                err);
-}
-
 static enum mps_status handshake(struct coupler *c, int k, const char *resolved_case,
                                  struct mps_err *err)
 {
@@ -481,11 +471,12 @@ static enum mps_status await_ready(struct coupler *c, int k, struct mps_err *err
             return mps_err_set(err, MPS_EPROTO, "solid READY carries no STATE");
         }
         c->state = m; /* keep: it is the fluid's first boundary */
-        if (!c->implicit)
-            return MPS_OK;
-        st = coupling_iter_init(&c->iter, &m, mps_case_double(c->cs, "coupling.implicit.tolerance"),
-                                mps_case_double(c->cs, "coupling.implicit.abs_tolerance"), err);
-        return st ? st : smooth_patches(c, err);
+        if (c->implicit)
+            return coupling_iter_init(&c->iter, &m,
+                                      mps_case_double(c->cs, "coupling.implicit.tolerance"),
+                                      mps_case_double(c->cs, "coupling.implicit.abs_tolerance"),
+                                      err);
+        return MPS_OK;
     }
     proto_msg_clear(&m);
     return MPS_OK;
@@ -680,10 +671,9 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
         if (!st && !converged && k >= c->max_iter && !rerun && !c->on_max_error)
             rerun = coupling_iter_best(&c->iter, &send); /* once more with the best */
         if (c->iter_log)
-            fprintf(c->iter_log, "%ld,%.9g,%d,%.6e,%.6e,%.6e,%.6g,%.6e,%.6e\n", c->step, c->time,
-                    k - 1, c->iter.change, c->iter.increment, c->iter.displacement,
-                    converged || k >= c->max_iter ? 0.0 : coupling_accel_last(c->accel),
-                    c->iter.change_all, c->iter.increment_all);
+            fprintf(c->iter_log, "%ld,%.9g,%d,%.6e,%.6e,%.6e,%.6g\n", c->step, c->time, k - 1,
+                    c->iter.change, c->iter.increment, c->iter.displacement,
+                    converged || k >= c->max_iter ? 0.0 : coupling_accel_last(c->accel));
         if (st)
             return mps_err_prefix(err, "step %ld at t = %.6g s, iteration %d: ", c->step,
                                   c->time, k - 1);
@@ -771,7 +761,7 @@ static enum mps_status get_implicit(struct coupler *c, struct mps_err *err)
     struct implicit_counters ic;
     enum mps_status st;
     if ((st = mps_ckpt_get(&c->disk, "implicit", &ic, sizeof ic, err)) ||
-        (st = coupling_iter_get(&c->iter, &c->disk, err)) || (st = smooth_patches(c, err)) ||
+        (st = coupling_iter_get(&c->iter, &c->disk, err)) ||
         (st = coupling_accel_get(c->accel, &c->disk, err)))
         return mps_err_prefix(err, "%s: ", c->restart_path);
     c->iterations = (long)ic.iterations;
@@ -1409,12 +1399,9 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
             return mps_err_set(err, MPS_EIO, "cannot create %s: %s", path, strerror(errno));
         } else {
             /* factor: the relaxation factor (constant, aitken) or the columns
-             * (iqn_ils) that chose the next iterate; 0 on the step's last.
-             * change and step displacement are the convergence test's (patch
-             * means with coupling.implicit.smooth), the _particles ones over
-             * every interface particle (the same without) */
+             * (iqn_ils) that chose the next iterate; 0 on the step's last */
             fputs("step,time,iteration,change_rms_m,step_displacement_rms_m,displacement_rms_m,"
-                  "factor,change_particles_rms_m,step_displacement_particles_rms_m\n",
+                  "factor\n",
                   c->iter_log);
         }
     }

@@ -38,10 +38,6 @@ const struct mps_key_spec coupler_case_keys[] = {
     {"coupling.implicit.abs_tolerance", MPS_KEY_DOUBLE, "1e-4", 0, 0, MPS_KEY_NO_HI, NULL, "m/s",
      "absolute part of the convergence test, as a velocity (an interface at rest has no "
      "displacement)"},
-    {"coupling.implicit.smooth", MPS_KEY_DOUBLE, "0", 0, 0, MPS_KEY_NO_HI, NULL, "dp",
-     "side of the square patches (in particle spacings) over whose means the convergence "
-     "test measures the change and the displacement (coupler/coupling_iter.h); 0: every "
-     "particle"},
     {"coupling.implicit.max_iterations", MPS_KEY_INT, "20", 1, 1000, 0, NULL, "",
      "iterations (fluid and solid solves) per step at most"},
     {"coupling.implicit.on_max", MPS_KEY_ENUM, "accept", 0, 0, 0, "accept|error", "",

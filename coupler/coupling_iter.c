@@ -59,92 +59,7 @@ void coupling_iter_free(struct coupling_iter *it)
     free(it->out);
     free(it->next);
     free(it->best);
-    free(it->grp_start);
-    free(it->grp_idx);
     memset(it, 0, sizeof *it);
-}
-
-/* qsort key of coupling_iter_smooth: the cell, then the index (a total
- * order, so the groups do not depend on the sort's stability) */
-struct cell_key {
-    long long c[MPS_DIM];
-    size_t k;
-};
-
-static int cmp_cell_only(const struct cell_key *p, const struct cell_key *q)
-{
-    for (int d = 0; d < MPS_DIM; d++)
-        if (p->c[d] != q->c[d])
-            return p->c[d] < q->c[d] ? -1 : 1;
-    return 0;
-}
-
-static int cmp_cell(const void *a, const void *b)
-{
-    const struct cell_key *p = a, *q = b;
-    int c = cmp_cell_only(p, q);
-    return c ? c : (p->k > q->k) - (p->k < q->k);
-}
-
-enum mps_status coupling_iter_smooth(struct coupling_iter *it, double h, struct mps_err *err)
-{
-    free(it->grp_start);
-    free(it->grp_idx);
-    it->grp_start = it->grp_idx = NULL;
-    it->ngrp = 0;
-    it->smooth = 0.0;
-    if (!(h >= 0.0))
-        return mps_err_set(err, MPS_EINPUT, "implicit coupling: patch side %g m", h);
-    if (h == 0.0 || it->n == 0)
-        return MPS_OK;
-    struct cell_key *key = malloc(it->n * sizeof *key);
-    it->grp_start = malloc((it->n + 1) * sizeof *it->grp_start);
-    it->grp_idx = malloc(it->n * sizeof *it->grp_idx);
-    if (!key || !it->grp_start || !it->grp_idx) {
-        free(key);
-        return mps_err_set(err, MPS_ENOMEM, "implicit coupling: out of memory for patches");
-    }
-    size_t m = 0;
-    for (size_t k = 0; k < it->n; k++) {
-        if (it->fixed[k])
-            continue;
-        key[m].k = k;
-        for (int d = 0; d < MPS_DIM; d++)
-            key[m].c[d] = (long long)floor(it->x0[k][d] / h);
-        m++;
-    }
-    qsort(key, m, sizeof *key, cmp_cell);
-    for (size_t q = 0; q < m; q++) {
-        if (q == 0 || cmp_cell_only(&key[q], &key[q - 1]) != 0)
-            it->grp_start[it->ngrp++] = q;
-        it->grp_idx[q] = key[q].k;
-    }
-    it->grp_start[it->ngrp] = m;
-    free(key);
-    it->smooth = h;
-    return MPS_OK;
-}
-
-/* sum over patches of (members) |patch mean of vec_k|^2, for vec_k = a_k - b_k */
-static double patch_sum(const struct coupling_iter *it, const double *a,
-                        const double (*b)[MPS_DIM])
-{
-    double sum = 0.0;
-    for (size_t g = 0; g < it->ngrp; g++) {
-        double total[MPS_DIM] = {0.0};
-        const size_t q0 = it->grp_start[g], q1 = it->grp_start[g + 1];
-        for (size_t q = q0; q < q1; q++) {
-            size_t k = it->grp_idx[q];
-            for (int d = 0; d < MPS_DIM; d++)
-                total[d] += a[MPS_DIM * k + d] - b[k][d];
-        }
-        /* members |mean|^2 = |total|^2 / members */
-        double s2 = 0.0;
-        for (int d = 0; d < MPS_DIM; d++)
-            s2 += total[d] * total[d];
-        sum += s2 / (double)(q1 - q0);
-    }
-    return sum;
 }
 
 /* A STATE from the solid must be READY's interface, in READY's order. */
@@ -234,12 +149,6 @@ enum mps_status coupling_iter_result(struct coupling_iter *it, const struct prot
     it->change = sqrt(ch * inv);
     it->displacement = sqrt(disp * inv);
     it->increment = sqrt(inc * inv);
-    it->change_all = it->change;
-    it->increment_all = it->increment;
-    if (it->ngrp) {
-        it->change = sqrt(patch_sum(it, it->out, (const double(*)[MPS_DIM])it->in) * inv);
-        it->increment = sqrt(patch_sum(it, it->out, (const double(*)[MPS_DIM])it->x_start) * inv);
-    }
     *converged = it->change <= it->tol * it->increment + it->atol * it->dt;
     it->last_k++;
     if (it->change <= it->best_change) { /* ties: the later, already the solvers' state */

@@ -21,19 +21,6 @@
  * initial positions plus atol, both as root mean squares over the interface
  * particles: rms|x_k - x~_k| <= tol rms|x_k - x_0| + atol.
  *
- * With coupling.implicit.smooth h > 0 both measures are taken after
- * averaging over patches of the body: the interface particles are grouped by
- * the square cell of side h their reference position (x_0) falls in, and
- * each vector (x_k - x~_k, x_k - x_start) is replaced by its mean over each
- * group, clamped particles left out (their rows are 0). Why: the added mass
- * that makes the weak coupling unstable is that of the body's smooth modes
- * (a wave of length l along a plate carries about rho l / (2 pi) of fluid per
- * face), while the miss of a first iterate is mostly the particle-scale
- * answer of the solid to the fluid's step-to-step load noise (docs/sloshing.md,
- * "Where it stands"), which explicit coupling passes stably. The patch means
- * are the part of the mismatch the iteration is there to remove. Off (0) by
- * default: the measures over every particle.
- *
  * The first input of a step is the linear extrapolation of the positions at
  * the last two steps' starts, x_n + (x_n - x_(n-1)) dt_n / dt_(n-1) (the
  * first step: x_0 + v_0 dt). It saves iterations: on the standard plate
@@ -67,13 +54,6 @@ struct coupling_iter {
     /* the last iteration's measures (m): rms|x_k - x~_k|, rms|x_k - x_0|,
      * rms|x_k - x_start| */
     double change, displacement, increment;
-    /* coupling.implicit.smooth: patch side (m; 0 = off), the groups as
-     * ranges grp_start[g] .. grp_start[g + 1] of grp_idx; change and
-     * increment above are then the patch measures, and these the measures
-     * over every particle (for the log) */
-    double smooth;
-    size_t ngrp, *grp_start, *grp_idx;
-    double change_all, increment_all;
 };
 
 /* From the solid's READY (its STATE payload: ids, order, flags and reference
@@ -81,11 +61,6 @@ struct coupling_iter {
 enum mps_status coupling_iter_init(struct coupling_iter *it, const struct proto_msg *ready,
                                    double tol, double atol, struct mps_err *err);
 void coupling_iter_free(struct coupling_iter *it);
-
-/* Patches of side h (m) for the convergence measures (header); h = 0 turns
- * them off. Call after coupling_iter_init and again after coupling_iter_get
- * (the groups follow x_0, which a restart reads back). */
-enum mps_status coupling_iter_smooth(struct coupling_iter *it, double h, struct mps_err *err);
 
 /* A step of dt starts from the solid's state now (the last RESULT): fills
  * send (a STATE message whose arrays live in it) with the first input. */

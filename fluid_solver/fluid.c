@@ -183,7 +183,6 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
     free(pts);
     f->nfluid = nf;
     f->nfixed_end = nf + nw;
-    f->id_end = nf + nw;
     fluid_body_accel(f, 0.0);
     if (prm->initial_hydrostatic)
         initial_pressure(f);
@@ -228,7 +227,6 @@ void fluid_destroy(struct fluid **pf)
     mps_nbr_list_free(&f->nl_tank);
     free(f->wlap);
     free(f->wcol);
-    free(f->warm);
     free(f->shadow_use);
     free(f->agg);
     free(f->aggkey);
@@ -657,43 +655,6 @@ static enum mps_status check_domain(const struct fluid *f, struct mps_err *err)
     return MPS_OK;
 }
 
-/* The key of particle i in f->warm (fluid.h): ids of tank and fluid
- * particles are below id_end and never change; the solid's are the solid's
- * own, so they go by their place, which every iteration of a step keeps. */
-static size_t warm_key(const struct fluid *f, size_t i)
-{
-    return i < f->nfixed_end ? (size_t)f->id[i] : f->id_end + (i - f->nfixed_end);
-}
-
-enum mps_status fluid_warm_keep(struct fluid *f, struct mps_err *err)
-{
-    f->warm_valid = 0;
-    if (!f->prm.ppe_warm_repeat)
-        return MPS_OK;
-    const size_t n = f->ps.n, need = f->id_end + (n - f->nfixed_end);
-    if (need > f->cap_warm) {
-        double *w = realloc(f->warm, need * sizeof *w);
-        if (!w)
-            return mps_err_set(err, MPS_ENOMEM, "fluid: out of memory for the PPE warm start");
-        f->warm = w;
-        f->cap_warm = need;
-    }
-    /* the solve's unclamped values where there was a row: the clamped ones
-     * would start the repeat further from its answer */
-    for (size_t i = 0; i < n; i++) {
-        int r = f->row[i];
-        f->warm[warm_key(f, i)] = r >= 0 && r < f->nrows ? f->sol[r] : f->p[i];
-    }
-    f->warm_n = need;
-    f->warm_valid = 1;
-    return MPS_OK;
-}
-
-void fluid_warm_drop(struct fluid *f)
-{
-    f->warm_valid = 0;
-}
-
 enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 {
     const struct fluid_params *p = &f->prm;
@@ -785,15 +746,6 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     st = fluid_ppe_assemble(f, dt, err);
     if (st)
         return st;
-    if (f->warm_valid) { /* a repeat: from the last iterate (fluid_warm_keep) */
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            size_t key = warm_key(f, i);
-            if (f->row[i] >= 0 && key < f->warm_n)
-                f->sol[f->row[i]] = f->warm[key];
-        }
-        f->warm_valid = 0;
-    }
     mps_timer_switch(&f->timer, PH_SOLVE);
     struct fluid_linsolve_stats ls;
     st = fluid_ppe_solve(f, &ls, err);

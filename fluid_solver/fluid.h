@@ -137,12 +137,6 @@ struct fluid {
     struct fluid_step_stats last;
     struct mps_timer timer;
     struct fluid_sensors *sens;   /* time means of the averaged probes (NULL: none) */
-    /* fluid.ppe_warm_repeat: the last iterate's PPE solution per particle
-     * key (tank and fluid particles by id, below id_end; the solid's by
-     * their place after it), the next assembly's start when warm_valid */
-    double *warm;
-    size_t cap_warm, warm_n, id_end;
-    int warm_valid;
 };
 
 /* Builds the tank and the water blocks from validated parameters. */
@@ -171,14 +165,6 @@ enum mps_status fluid_set_solid(struct fluid *f, size_t n, const int *id,
  * fluid_set_solid (surface ones only); returns the count. */
 size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
                          double (*force)[MPS_DIM], size_t max);
-
-/* Implicit coupling, before the step is rolled back for a repeat: keeps
- * the PPE solution of the iterate just done so that the repeat's PPE starts
- * from it (fluid.ppe_warm_repeat; a no-op without it). The state restored
- * afterwards does not hold it: it is used by the next assembly only.
- * fluid_warm_drop forgets it (a new step starts from its own pressure). */
-enum mps_status fluid_warm_keep(struct fluid *f, struct mps_err *err);
-void fluid_warm_drop(struct fluid *f);
 
 /* Recomputes the type masks (has_p, is_fluid) after particle types change. */
 void fluid_update_masks(struct fluid *f);

@@ -127,10 +127,6 @@ const struct mps_key_spec fluid_case_keys[] = {
      "linear solver for the PPE"},
     {"fluid.ppe_rtol", MPS_KEY_DOUBLE, "1e-6", 0, 0.1, MPS_KEY_LO_OPEN, NULL, "",
      "relative residual of iterative PPE solves"},
-    {"fluid.ppe_warm_repeat", MPS_KEY_BOOL, "false", 0, 0, 0, NULL, "",
-     "implicit coupling: a repeated step's PPE starts from the last iterate's solution "
-     "instead of the step's starting pressure (fewer PCG iterations; the repeat then "
-     "depends on the iteration before it, docs/coupling.md)"},
     {"fluid.ppe_max_iter", MPS_KEY_INT, "2000", 1, 0, NOHI, NULL, "", "iteration cap"},
     {"fluid.ppe_drop", MPS_KEY_DOUBLE, "0.015", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
      "pcg_sic0: couplings with a_ij^2 < drop^2 a_ii a_jj are left out of the incomplete "
@@ -355,7 +351,6 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");
     p->step_log = mps_case_bool(c, "fluid.step_log");
     p->ppe_rtol = mps_case_double(c, "fluid.ppe_rtol");
-    p->ppe_warm_repeat = mps_case_bool(c, "fluid.ppe_warm_repeat");
     p->ppe_max_iter = (int)mps_case_int(c, "fluid.ppe_max_iter");
     p->ppe_drop = mps_case_double(c, "fluid.ppe_drop");
     p->ppe_coarse_cell = mps_case_double(c, "fluid.ppe_coarse_cell");

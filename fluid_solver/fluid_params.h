@@ -90,7 +90,6 @@ struct fluid_params {
     const char *ppe_solver;
     int step_log;                 /* write PREFIX_steps.csv */
     double ppe_rtol;
-    int ppe_warm_repeat;          /* a repeat's PPE starts from the last iterate (fluid_warm_keep) */
     int ppe_max_iter;
     double ppe_drop;       /* pcg_sic0 drop threshold */
     double ppe_coarse_cell;       /* pcg_defl aggregate cell side, in dp */

@@ -467,16 +467,13 @@ static enum mps_status peer_save(void *self, struct mps_err *err)
 {
     struct run *r = self;
     r->saved_snapshots = mps_h5_count(r->h5);
-    fluid_warm_drop(r->f); /* a new step: its first iterate from its own pressure */
     return fluid_ckpt_save(r->f, &r->ckpt, err);
 }
 
 static enum mps_status peer_restore(void *self, struct mps_err *err)
 {
     struct run *r = self;
-    enum mps_status st = fluid_warm_keep(r->f, err);
-    if (!st)
-        st = fluid_ckpt_restore(r->f, &r->ckpt, err);
+    enum mps_status st = fluid_ckpt_restore(r->f, &r->ckpt, err);
     return st ? st : mps_h5_rewind(r->h5, r->saved_snapshots, err);
 }
 

@@ -146,38 +146,6 @@ int main(void)
     coupling_iter_free(&run);
     mps_ckpt_free(&ck);
 
-    /* patches (coupling.implicit.smooth): particles 4 and 7 share the cell
-     * of side 2 their reference positions (0,0) and (0,1) fall in; the
-     * clamped 9 is left out. A mismatch of +-e between the two (particle
-     * scale) has no patch mean and converges; the same mismatch in common is
-     * measured as over every particle, and a negative side is refused. */
-    struct coupling_iter pt;
-    CHECK(coupling_iter_init(&pt, &ready, 0.1, 0.0, &err) == MPS_OK);
-    CHECK(coupling_iter_smooth(&pt, -1.0, &err) == MPS_EINPUT);
-    CHECK(coupling_iter_smooth(&pt, 2.0, &err) == MPS_OK && pt.ngrp == 1);
-    for (int pass = 0; pass < 2; pass++) {
-        CHECK(coupling_iter_start(&pt, &ready, dt, &send, &err) == MPS_OK); /* x0 + v0 dt */
-        const double e = 0.002; /* 20% of the step's displacement 0.01 */
-        double x5[N][2] = {{0.01 + e, 0}, {0.01 + (pass ? e : -e), 1}, {0, -1}};
-        struct proto_msg r5 = state(x5, v1);
-        pt.dt_prev = 0.0;
-        CHECK(coupling_iter_result(&pt, &r5, &conv, &err) == MPS_OK);
-        CHECK_NEAR(pt.change_all, sqrt(2 * e * e / 3), 1e-15);
-        CHECK_NEAR(pt.change, pass ? sqrt(2 * e * e / 3) : 0.0, 1e-15);
-        CHECK(conv == !pass);
-        /* the patch displacement: both moved by about 0.01 */
-        CHECK_NEAR(pt.increment, sqrt(2 * pow(0.01 + (pass ? e : 0.0), 2) / 3), 1e-15);
-    }
-    /* patches smaller than the spacing: each particle alone, the measures
-     * over every particle */
-    CHECK(coupling_iter_smooth(&pt, 0.5, &err) == MPS_OK && pt.ngrp == 2);
-    CHECK(coupling_iter_start(&pt, &ready, dt, &send, &err) == MPS_OK);
-    double x6[N][2] = {{0.012, 0}, {0.008, 1}, {0, -1}};
-    struct proto_msg r6 = state(x6, v1);
-    CHECK(coupling_iter_result(&pt, &r6, &conv, &err) == MPS_OK);
-    CHECK(pt.change == pt.change_all && pt.increment == pt.increment_all && !conv);
-    coupling_iter_free(&pt);
-
     coupling_accel_destroy(&a);
     return test_summary("test_coupling_iter");
 }
