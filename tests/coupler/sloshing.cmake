@@ -40,13 +40,12 @@ set_tests_properties(coupled_motion_refused_by_python_solid coupled_motion_refus
 # run so, these tests read lags of 9.7 (low) and 55.2 degrees (high) at 2.22
 # and 1.55 iterations per step. The high filling alone on the quiet machine
 # (two threads, this command with either scheme): 90 s implicit, 54 s
-# explicit; beside a 1 mm run and the rest
-# of the suite both implicit tests timed out at 600 s (the explicit ones took
-# 77 and 118 s in a ctest -j2 of a few tests on the quiet machine). The
-# implicit coupling has its own tests
-# (tests/coupler/implicit.cmake). Measured lags with the explicit coupling: 4.2 and 41.5
-# (the solid refined twice), 14 and 51 (not refined); the band -30..120
-# takes any damped response short of a mirrored one.
+# explicit; beside a 1 mm run and the rest of the suite both implicit tests
+# timed out at 600 s (the explicit ones took 77 and 118 s in a ctest -j2 of a
+# few tests on the quiet machine). The implicit coupling has its own tests
+# (tests/coupler/implicit.cmake). Measured lags with the explicit coupling:
+# 4.2 and 41.5 (the solid refined twice), 14 and 51 (not refined); the band
+# -30..120 takes any damped response short of a mirrored one.
 foreach(fill low high)
   add_test(NAME coupled_sloshing_${fill}_coarse
     COMMAND sh -c "${COUPLER} cases/sloshing_${fill}/case.yml --out ${SLOSH_OUT}/${fill}_2mm --quiet --set dp=0.002 --set end_time=2.0 --set output.interval=0 --set fluid.tank.width=0.610 --set fluid.blocks.1.x1=0.610 --set motion.pivot.x=0.305 --set fluid.dt_max=1e-3 --set coupling.scheme=explicit && /usr/bin/python3 tests/coupler/sloshing_check.py ${SLOSH_OUT}/${fill}_2mm --lag-band -30 120"
