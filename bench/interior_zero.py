@@ -14,11 +14,13 @@ number density also rises with disorder (bench/water_volume.py --jitter),
 so the cells' mean says whether the bulk has expanded (1.0 is the starting
 lattice's area per particle). Particles near the surface are left out of the
 mean: their cells reach into the air or are cut by it.
-With several RUNs (realisations of one setting) the last line gives the
-mean over the runs of each column at each snapshot index."""
+With several RUNs (realisations of one setting) a last block gives the
+mean over the runs of each column at each snapshot index.
+Exit 1 if a RUN has no fluid snapshot."""
 import argparse
 import glob
 import os
+import sys
 
 import h5py
 import numpy as np
@@ -67,7 +69,11 @@ def main():
           'surface | deep cells\' mean area (dp^2)' % (a.deep, a.deep))
     for run in a.runs:
         rows = []
-        for fn in sorted(glob.glob(os.path.join(run, 'fluid_*.h5'))):
+        files = sorted(glob.glob(os.path.join(run, 'fluid_*.h5')))
+        if not files:
+            print('interior_zero.py: %s: no fluid snapshot (fluid_*.h5)' % run, file=sys.stderr)
+            return 1
+        for fn in files:
             s = snapshot(fn, a.dp, a.deep)
             if s is None or s[0] <= a.after:
                 continue
