@@ -737,8 +737,12 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
         for (size_t i = nf; i < n; i++)
             for (int d = 0; d < MPS_DIM; d++)
                 f->vstar[i][d] = f->v[i][d] + (f->ghost[i] ? dt : 0.0) * f->acc[i][d];
-        struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
-        mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
+        /* on the Laplacian's stencil the assembly computes it
+         * (fluid_ppe.c), from the weights it has anyway */
+        if (!p->divergence_wide) {
+            struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
+            mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
+        }
     }
 
     /* Eq. 23 */

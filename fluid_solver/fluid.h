@@ -64,7 +64,8 @@ struct fluid {
     double (*acc)[MPS_DIM];    /* body force per unit mass: gravity, or in a moving tank
                                 * the frame's (mps_motion.h); fluid_body_accel fills it */
     double *p;
-    double *div;           /* divergence of v* (mixed PPE source) */
+    double *div;           /* divergence of v* (mixed PPE source; on the Laplacian's
+                            * stencil fluid_ppe_assemble fills it) */
     double *nd;            /* particle number density n* (re_n) */
     double *nq;            /* mps_ops_number_density_quadratic's at x* (fluid.density_weight) */
     int *ncount;           /* neighbours within re_n */

@@ -45,6 +45,12 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
+    {"fluid.divergence_stencil", MPS_KEY_ENUM, "gradient", 0, 0, 0, "gradient|laplacian", "",
+     "neighbours of Eq. 10's divergence in the mixed source: the gradient's (re_n, the "
+     "paper's radius for Eq. 10) or the Laplacian's (re_lap, the stencil the PPE projects "
+     "with: the projection then removes what the source measures, and the flicker mostly "
+     "goes; with fluid.density_weight = quadratic, docs/pressure.md, \"The divergence on "
+     "the Laplacian's stencil\")"},
     {"fluid.initial_pressure", MPS_KEY_ENUM, "hydrostatic", 0, 0, 0, "hydrostatic|zero", "",
      "pressure at t = 0: hydrostatic below the top of the water above each particle, or zero"},
     {"fluid.density_weight", MPS_KEY_ENUM, "mps", 0, 0, 0, "mps|quadratic", "",
@@ -303,6 +309,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->density_quadratic = strcmp(mps_case_string(c, "fluid.density_weight"), "quadratic") == 0;
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
+    p->divergence_wide = strcmp(mps_case_string(c, "fluid.divergence_stencil"), "laplacian") == 0;
     p->initial_hydrostatic =
         strcmp(mps_case_string(c, "fluid.initial_pressure"), "hydrostatic") == 0;
     p->re_n = mps_case_double(c, "fluid.re_n");

@@ -290,6 +290,16 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     /* rho_inertial: rho, or with side walls rho (1 + delta / b), the inertia
      * the pressure's correction moves (fluid_create) */
     const double div_coef = f->rho_inertial / dt;
+    /* Eq. 10 on the Laplacian's neighbours (fluid.divergence_stencil), from
+     * the weights pass 1 packed: d / n0 at re_lap times sum_j w_ij
+     * (v*_j - v*_i).r_ij / r_ij^2, w_ij being wlap / c. The projection
+     * removes what this measures far better than Eq. 10 at re_n: at re_n
+     * 80% of the divergence was left after it, came back the next step and
+     * was projected again, as pressure noise times rho/dt (docs/pressure.md). */
+    const int div_wide = mixed && p->divergence_wide;
+    const double div_norm = MPS_DIM / (c * f->n0_lap);
+    const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
+    const double(*xs)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
 
     /* pass 1: weights, and entries per row (+1 for the diagonal); the
      * diagonal sum goes to rhs temporarily */
@@ -327,10 +337,19 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         int *cols = f->col + s;
         double *vals = f->val + s, diag = f->rhs[r];
         int q = 1;
-        double ghost = 0.0;
+        double ghost = 0.0, dsum = 0.0;
         const size_t k0 = f->nl.start[i];
         for (size_t k = k0; k < k0 + (size_t)f->nwlap[i]; k++) {
             int j = f->wcol[k];
+            if (div_wide) {
+                double r2 = 0.0, dv = 0.0;
+                for (int d = 0; d < MPS_DIM; d++) {
+                    double dx = xs[j][d] - xs[i][d];
+                    r2 += dx * dx;
+                    dv += (vs[j][d] - vs[i][d]) * dx;
+                }
+                dsum += r2 > 0.0 ? f->wlap[k] * dv / r2 : 0.0;
+            }
             if (f->row[j] >= 0) {
                 cols[q] = f->row[j];
                 vals[q++] = -f->wlap[k];
@@ -354,6 +373,8 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         double dn = p->density_quadratic ? f->n0 * (f->nq[i] / f->nq0 - 1.0) : f->nd[i] - f->n0;
         dn = dead_band(dn, band);
         f->rhs[r] = ghost + src * dn;
+        if (div_wide)
+            f->div[i] = div_norm * dsum;
         if (mixed) /* with Neumann walls compressibility acts on the change of
                     * pressure, see fluid_ppe.h */
             f->rhs[r] += (ghosts ? comp * f->p[i] : 0.0) - f->div[i] * div_coef;

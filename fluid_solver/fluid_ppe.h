@@ -8,7 +8,8 @@
  *   c sum_j w_ij (P_i - P_j) + (rho alpha / dt^2) P_i = rhs_i,  c = 2d/(lambda n0),
  * symmetric, positive definite, diagonally dominant.
  * rhs_i, density source (Eq. 23): kappa rho/dt^2 (n*_i - n0)/n0.
- * rhs_i, mixed source: the same plus -(rho/dt) div v*_i, and with Neumann
+ * rhs_i, mixed source: the same plus -(rho/dt) div v*_i (Eq. 10 on the
+ *   Laplacian's neighbours by default, fluid.divergence_stencil), and with Neumann
  *   walls (also solid_ppe) + (rho alpha/dt^2) P^n_i: continuity with the equation of state
  *   (Eq. 21) over one step, alpha (P^{n+1} - P^n)/dt = -div v^{n+1}, so
  *   compressibility acts on the change of pressure and still water keeps its
