@@ -48,9 +48,9 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.divergence_stencil", MPS_KEY_ENUM, "gradient", 0, 0, 0, "gradient|laplacian", "",
      "neighbours of Eq. 10's divergence in the mixed source: the gradient's (re_n, the "
      "paper's radius for Eq. 10) or the Laplacian's (re_lap, the stencil the PPE projects "
-     "with: the projection then removes what the source measures, and the flicker mostly "
-     "goes; with fluid.density_weight = quadratic, docs/pressure.md, \"The divergence on "
-     "the Laplacian's stencil\")"},
+     "with: it measures about half as much of the divergence the projection leaves, and "
+     "most of the pressure flicker goes; use it with fluid.density_weight = quadratic, "
+     "docs/pressure.md, \"The divergence on the Laplacian's stencil\")"},
     {"fluid.initial_pressure", MPS_KEY_ENUM, "hydrostatic", 0, 0, 0, "hydrostatic|zero", "",
      "pressure at t = 0: hydrostatic below the top of the water above each particle, or zero"},
     {"fluid.density_weight", MPS_KEY_ENUM, "mps", 0, 0, 0, "mps|quadratic", "",

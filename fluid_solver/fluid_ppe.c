@@ -292,10 +292,11 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
     const double div_coef = f->rho_inertial / dt;
     /* Eq. 10 on the Laplacian's neighbours (fluid.divergence_stencil), from
      * the weights pass 1 packed: d / n0 at re_lap times sum_j w_ij
-     * (v*_j - v*_i).r_ij / r_ij^2, w_ij being wlap / c. The projection
-     * removes what this measures far better than Eq. 10 at re_n: at re_n
-     * 80% of the divergence was left after it, came back the next step and
-     * was projected again, as pressure noise times rho/dt (docs/pressure.md). */
+     * (v*_j - v*_i).r_ij / r_ij^2, w_ij being wlap / c. Most of the
+     * divergence Eq. 10 measures is left after the projection and comes
+     * back the next step, projected again as pressure noise times rho/dt;
+     * over re_lap Eq. 10 measures about half as much of it as over re_n
+     * (docs/pressure.md, "The divergence on the Laplacian's stencil"). */
     const int div_wide = mixed && p->divergence_wide;
     const double div_norm = MPS_DIM / (c * f->n0_lap);
     const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
