@@ -543,6 +543,61 @@ static void surface_scan(struct fluid *f)
     }
 }
 
+/* A flow along a wall made of fixed particles otherwise reads as a
+ * divergence that depends on where the particle sits over the wall's
+ * lattice, u/dp times that asymmetry (docs/pressure.md, "Walls that slip in
+ * Eq. 10"). The pressure only holds the normal component at a wall anyway.
+ * A particle of a tank corner (outside both faces) keeps its own velocity;
+ * solids keep theirs. */
+void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows)
+{
+    const struct fluid_params *p = &f->prm;
+    const double re = p->re_n * p->dp, re2 = re * re, coef = MPS_DIM / f->n0;
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
+    const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
+#pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
+    for (size_t i = 0; i < f->ps.n; i++) {
+        if (!rows[i])
+            continue;
+        double acc = 0.0;
+        for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
+            const int j = f->nl_n.j[k];
+            double dx[MPS_DIM], r2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                dx[d] = x[j][d] - x[i][d];
+                r2 += dx[d] * dx[d];
+            }
+            if (r2 >= re2 || r2 <= 0.0)
+                continue;
+            double rel[MPS_DIM], nrm[MPS_DIM] = {0.0};
+            for (int d = 0; d < MPS_DIM; d++)
+                rel[d] = vs[j][d] - vs[i][d];
+            if (f->type[j] == WALL_P || f->type[j] == DUMMY_P) {
+                const double *xj = x[j];
+                if (xj[1] < 0.0 && xj[0] >= 0.0 && xj[0] <= p->tank_w)
+                    nrm[1] = 1.0;
+                else if (xj[0] < 0.0 && xj[1] >= 0.0)
+                    nrm[0] = 1.0;
+                else if (xj[0] > p->tank_w && xj[1] >= 0.0)
+                    nrm[0] = -1.0;
+                else if (p->tank_lid && xj[1] > p->tank_h)
+                    nrm[1] = -1.0;
+                double rn = 0.0;
+                for (int d = 0; d < MPS_DIM; d++)
+                    rn += rel[d] * nrm[d];
+                if (rn != 0.0 || nrm[0] != 0.0 || nrm[1] != 0.0)
+                    for (int d = 0; d < MPS_DIM; d++)
+                        rel[d] = rn * nrm[d];
+            }
+            double dv = 0.0;
+            for (int d = 0; d < MPS_DIM; d++)
+                dv += rel[d] * dx[d];
+            acc += (re / sqrt(r2) - 1.0) * dv / r2;
+        }
+        f->div[i] = coef * acc;
+    }
+}
+
 /* Counts one use of the guard on face (0 floor, 1 left, 2 right, 3 lid) by
  * the particle at x (before it is put back); the first use is kept whole,
  * for the summary: a leak shows where and when it started. */
@@ -739,7 +794,9 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
                 f->vstar[i][d] = f->v[i][d] + (f->ghost[i] ? dt : 0.0) * f->acc[i][d];
         /* on the Laplacian's stencil the assembly computes it
          * (fluid_ppe.c), from the weights it has anyway */
-        if (!p->divergence_wide) {
+        if (!p->divergence_wide && p->divergence_slip) {
+            fluid_divergence_slip_walls(f, rows);
+        } else if (!p->divergence_wide) {
             struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
             mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
         }

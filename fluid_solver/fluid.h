@@ -167,6 +167,13 @@ enum mps_status fluid_set_solid(struct fluid *f, size_t n, const int *id,
 size_t fluid_solid_loads(const struct fluid *f, int *id, double *pressure,
                          double (*force)[MPS_DIM], size_t max);
 
+/* Eq. 10 on f->vstar over nl_n (re_n) into f->div for the particles with
+ * rows[i], the tank's wall and dummy neighbours slipping
+ * (fluid.divergence_walls = slip): such a neighbour j enters with v*_j plus
+ * the tangential part of v*_i - v*_j along its face, so that only the
+ * approach normal to the wall counts. */
+void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows);
+
 /* Recomputes the type masks (has_p, is_fluid) after particle types change. */
 void fluid_update_masks(struct fluid *f);
 

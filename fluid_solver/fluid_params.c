@@ -51,6 +51,11 @@ const struct mps_key_spec fluid_case_keys[] = {
      "with: it measures about half as much of the divergence the projection leaves, and "
      "most of the pressure flicker goes; use it with fluid.density_weight = quadratic, "
      "docs/pressure.md, \"The divergence on the Laplacian's stencil\")"},
+    {"fluid.divergence_walls", MPS_KEY_ENUM, "slip", 0, 0, 0, "slip|fixed", "",
+     "the tank's wall and dummy particles in Eq. 10 of the mixed source (re_n): at their "
+     "velocity (fixed) or slipping, only the approach normal to the wall counted (slip: a "
+     "flow along a wall otherwise reads as a divergence that follows the wall's lattice, "
+     "docs/pressure.md, \"Walls that slip in Eq. 10\")"},
     {"fluid.initial_pressure", MPS_KEY_ENUM, "hydrostatic", 0, 0, 0, "hydrostatic|zero", "",
      "pressure at t = 0: hydrostatic below the top of the water above each particle, or zero"},
     {"fluid.density_weight", MPS_KEY_ENUM, "mps", 0, 0, 0, "mps|quadratic", "",
@@ -310,6 +315,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
     p->divergence_wide = strcmp(mps_case_string(c, "fluid.divergence_stencil"), "laplacian") == 0;
+    p->divergence_slip = strcmp(mps_case_string(c, "fluid.divergence_walls"), "slip") == 0;
     p->initial_hydrostatic =
         strcmp(mps_case_string(c, "fluid.initial_pressure"), "hydrostatic") == 0;
     p->re_n = mps_case_double(c, "fluid.re_n");
