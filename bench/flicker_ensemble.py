@@ -31,7 +31,7 @@ sys.path.insert(0, os.path.join(ROOT, 'tests', 'coupler'))
 import check_flicker  # noqa: E402
 import plate_compare as pc  # noqa: E402
 from check_plate_flicker import force_smoothness  # noqa: E402
-from probes_csv import probes_table  # noqa: E402
+from pressure_quality import step_shares  # noqa: E402
 
 
 def run(cmd, out):
@@ -50,9 +50,7 @@ def dambreak(build, out, seed, sets):
          '--set', 'dp=0.004', '--set', 'end_time=0.3', '--set', 'output.interval=0.02',
          '--set', 'fluid.step_log=true', '--set', 'fluid.jitter.amplitude=0.001',
          '--set', 'fluid.jitter.seed=%d' % seed] + sets, out)
-    log = probes_table(os.path.join(out, 'fluid_steps.csv'))
-    m = log['time'] > 0.05
-    per_step = log['rows_at_zero'][m] / log['ppe_rows'][m]
+    _, per_step = step_shares(out, 0.05)
     snaps = [s for _, s in check_flicker.shares(out, 0.05)]
     summ = json.load(open(os.path.join(out, 'summary.json')))
     return [100 * per_step.mean(), 100 * np.mean(per_step > 0.05),

@@ -585,7 +585,7 @@ void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows)
                 double rn = 0.0;
                 for (int d = 0; d < MPS_DIM; d++)
                     rn += rel[d] * nrm[d];
-                if (rn != 0.0 || nrm[0] != 0.0 || nrm[1] != 0.0)
+                if (nrm[0] != 0.0 || nrm[1] != 0.0)
                     for (int d = 0; d < MPS_DIM; d++)
                         rel[d] = rn * nrm[d];
             }
