@@ -30,12 +30,12 @@ const struct mps_key_spec fluid_case_keys[] = {
      "does); a longer step corrects kappa, as printed. 0 (default): always as printed; "
      "5e-4 halves the dam break's flicker but the 3 mm plate's water expands over the walls "
      "(docs/pressure.md)"},
-    {"fluid.kappa_step_decay", MPS_KEY_DOUBLE, "0", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
+    {"fluid.kappa_step_decay", MPS_KEY_DOUBLE, "0.95", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
      "the step that scales Eq. 23's correction (kappa rho / (dt dtk)) falls by at most this "
      "factor per step: after the CFL step drops at an impact the correction strengthens "
      "over several steps instead of quadrupling its pressure at once (dtk = max(dt, "
-     "decay x the previous step's dtk)); 0 (default): dtk = dt, as printed; 0.95: about "
-     "14 steps to follow a halved step (docs/pressure.md)"},
+     "decay x the previous step's dtk)); 0: dtk = dt, as printed; 0.95 (default): about "
+     "14 steps to follow a halved step (the default since 2026-12-04, docs/pressure.md)"},
     {"fluid.density_dead_band", MPS_KEY_DOUBLE, "0.0005", 0, 0.05, 0, NULL, "n0",
      "Eq. 23's density error is corrected only beyond this fraction of n0, by its excess "
      "(a soft threshold): an error below it is the lattice's own noise, and correcting it "

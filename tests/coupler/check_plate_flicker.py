@@ -37,7 +37,11 @@ def force_smoothness(run_dir, column='solid_fx'):
     10% of the peak, where the force passes through zero), the RMS of the
     deviation and the mean change from row to row."""
     p = probes_table(os.path.join(run_dir, 'probes.csv'))
-    t, fx = p['time'], p[column]
+    return force_series_smoothness(p['time'], p[column])
+
+
+def force_series_smoothness(t, fx):
+    """force_smoothness on a force series fx at times t."""
     peak = np.abs(fx).max()
     t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
     w = max(1, int(round(0.02 / np.median(np.diff(t)))))

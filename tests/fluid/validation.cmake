@@ -93,6 +93,18 @@ add_test(NAME fluid_pressure_flicker_steps
           -- ${FV_SOLVER} cases/dambreak/case.yml --set dp=0.008 --set end_time=0.3
              --set output.interval=0 --set fluid.step_log=true
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# fluid_dambreak_flicker_realisations: the issue's target on the 4 mm dam
+# break to 0.3 s (snapshots every 0.02 s), in each of 8 jittered realisations
+# (bench/flicker_ensemble.py, one thread): no snapshot after 0.05 s with more
+# than 5% of the interior fluid at P = 0. Measured (2026-12-04) with the
+# defaults (walls slipping in Eq. 10, fluid.kappa_step_decay 0.95): worst
+# 1.95-3.52%; without the decay 4 of 8 over (41-63% at the impact on the
+# right wall, where the CFL step drops); with the walls fixed 2.9 snapshots
+# over per realisation. The band is the target itself: 5% is 1.5 points above
+# the worst realisation, and one impact step that goes wrong reads 40-60%.
+add_test(NAME fluid_dambreak_flicker_realisations
+  COMMAND sh -c "rm -rf '${FV_OUT}/flicker_realisations' && /usr/bin/python3 bench/flicker_ensemble.py --build '${CMAKE_BINARY_DIR}' --runs 8 --out '${FV_OUT}/flicker_realisations' --max-worst 5"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # fluid_pressure_flicker_laplacian: the option pair of docs/pressure.md, "The
 # divergence on the Laplacian's stencil" (fluid.divergence_stencil =
 # laplacian, fluid.density_weight = quadratic), on the 8 mm dam break to 0.3 s:
@@ -163,6 +175,7 @@ add_test(NAME fluid_still_water_short_steps
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(fluid_valid_hydrostatic fluid_valid_dambreak fluid_stable_dambreak
   fluid_ppe_scaling fluid_pressure_flicker fluid_pressure_flicker_steps
+  fluid_dambreak_flicker_realisations
   fluid_pressure_flicker_laplacian
   fluid_still_water_laplacian_10s fluid_still_water_10s
   fluid_still_water_default_10s fluid_still_water_short_steps
