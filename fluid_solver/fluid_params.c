@@ -45,12 +45,17 @@ const struct mps_key_spec fluid_case_keys[] = {
     {"fluid.ppe_source", MPS_KEY_ENUM, "mixed", 0, 0, 0, "density|mixed", "",
      "PPE source: density deviation only (Eq. 23), or mixed with the divergence of the "
      "predicted velocity (Tanaka & Masunaga 2010), see docs/fluid.md"},
-    {"fluid.divergence_stencil", MPS_KEY_ENUM, "gradient", 0, 0, 0, "gradient|laplacian", "",
+    {"fluid.divergence_stencil", MPS_KEY_ENUM, "near_bodies", 0, 0, 0,
+     "gradient|laplacian|near_bodies", "",
      "neighbours of Eq. 10's divergence in the mixed source: the gradient's (re_n, the "
-     "paper's radius for Eq. 10) or the Laplacian's (re_lap, the stencil the PPE projects "
+     "paper's radius for Eq. 10), the Laplacian's (re_lap, the stencil the PPE projects "
      "with: it measures about half as much of the divergence the projection leaves, and "
      "most of the pressure flicker goes; use it with fluid.density_weight = quadratic, "
-     "docs/pressure.md, \"The divergence on the Laplacian's stencil\")"},
+     "docs/pressure.md, \"The divergence on the Laplacian's stencil\"), or the Laplacian's "
+     "in the rows that reach a solid body within re_lap and the gradient's elsewhere "
+     "(near_bodies: the plate's force as smooth as with the Laplacian's everywhere, still "
+     "water and runs without bodies as with the gradient's; docs/pressure.md, \"The "
+     "divergence near bodies\")"},
     {"fluid.divergence_walls", MPS_KEY_ENUM, "slip", 0, 0, 0, "slip|fixed", "",
      "the tank's wall and dummy particles in Eq. 10 of the mixed source (re_n): at their "
      "velocity (fixed) or slipping, only the approach normal to the wall counted (slip: a "
@@ -315,6 +320,8 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->alpha = mps_case_double(c, "fluid.alpha");
     p->mixed_source = strcmp(mps_case_string(c, "fluid.ppe_source"), "mixed") == 0;
     p->divergence_wide = strcmp(mps_case_string(c, "fluid.divergence_stencil"), "laplacian") == 0;
+    p->divergence_near_bodies =
+        strcmp(mps_case_string(c, "fluid.divergence_stencil"), "near_bodies") == 0;
     p->divergence_slip = strcmp(mps_case_string(c, "fluid.divergence_walls"), "slip") == 0;
     p->initial_hydrostatic =
         strcmp(mps_case_string(c, "fluid.initial_pressure"), "hydrostatic") == 0;

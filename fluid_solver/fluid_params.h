@@ -63,6 +63,7 @@ struct fluid_params {
     int droplet_neighbours; /* fewer neighbours within re_n: outside Eq. 52 */
     int mixed_source;             /* add the velocity-divergence source term */
     int divergence_wide;          /* its Eq. 10 on the Laplacian's neighbours (re_lap) */
+    int divergence_near_bodies;   /* ... only in the rows that reach a solid body */
     int divergence_slip;          /* its Eq. 10 with the tank's walls slipping */
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */

@@ -298,6 +298,14 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
      * over re_lap Eq. 10 measures about half as much of it as over re_n
      * (docs/pressure.md, "The divergence on the Laplacian's stencil"). */
     const int div_wide = mixed && p->divergence_wide;
+    /* fluid.divergence_stencil = near_bodies: the rows that reach a solid
+     * particle within re_lap (and the solid's own rows) take it on the
+     * Laplacian's stencil too, the others keep Eq. 10 at re_n from
+     * fluid.c: the plate's force is then as smooth as with the wide
+     * divergence everywhere, and the free surface away from bodies keeps
+     * the narrow one, without which Eq. 7's density term lets still water
+     * go unstable (docs/pressure.md, "The divergence near bodies"). */
+    const int div_near = mixed && p->divergence_near_bodies && n > f->nfixed_end;
     const double div_norm = MPS_DIM / (c * f->n0_lap);
     const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
     const double(*xs)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
@@ -339,10 +347,12 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         double *vals = f->val + s, diag = f->rhs[r];
         int q = 1;
         double ghost = 0.0, dsum = 0.0;
+        int body = div_near && i >= f->nfixed_end;
         const size_t k0 = f->nl.start[i];
         for (size_t k = k0; k < k0 + (size_t)f->nwlap[i]; k++) {
             int j = f->wcol[k];
-            if (div_wide) {
+            body |= div_near && (size_t)j >= f->nfixed_end;
+            if (div_wide || div_near) {
                 double r2 = 0.0, dv = 0.0;
                 for (int d = 0; d < MPS_DIM; d++) {
                     double dx = xs[j][d] - xs[i][d];
@@ -374,7 +384,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         double dn = p->density_quadratic ? f->n0 * (f->nq[i] / f->nq0 - 1.0) : f->nd[i] - f->n0;
         dn = dead_band(dn, band);
         f->rhs[r] = ghost + src * dn;
-        if (div_wide)
+        if (div_wide || body)
             f->div[i] = div_norm * dsum;
         if (mixed) /* with Neumann walls compressibility acts on the change of
                     * pressure, see fluid_ppe.h */

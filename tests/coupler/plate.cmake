@@ -61,8 +61,17 @@ add_test(NAME coupled_plate_kappa_step_decay
 add_test(NAME coupled_plate_flicker_laplacian
          COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6_laplacian --quiet --set dp=0.006 --set end_time=2 --set fluid.divergence_stencil=laplacian --set fluid.density_weight=quadratic && /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate6_laplacian --min-within15 0.85 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6_laplacian --tmax 0.5 --peak-band 0.041 0.049 --peak-time 0.22 0.26 --rms-max 0.009"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+#  - the default fluid.divergence_stencil = near_bodies (docs/pressure.md, "The
+#    divergence near bodies"), 2 s: at least 84% of the 2 ms force rows within
+#    15% of their 20 ms mean, the tip as above. Measured (2026-12-04): eight
+#    jittered starts 87.3-90.6% (one thread), the lattice start 91% (two
+#    threads); with Eq. 10 at re_n everywhere (gradient, the default before)
+#    73.4-79.2%. 84% sits between, three points under the lowest realisation.
+add_test(NAME coupled_plate_flicker_near_bodies
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate6_near_bodies --quiet --set dp=0.006 --set end_time=2 && /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate6_near_bodies --min-within15 0.84 && /usr/bin/python3 bench/plate_compare.py ${CMAKE_BINARY_DIR}/test_out/plate6_near_bodies --tmax 0.5 --peak-band 0.041 0.049 --peak-time 0.22 0.26 --rms-max 0.009"
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupled_plate_flicker_scan coupled_plate_kappa_step_decay
-                     coupled_plate_flicker_laplacian
+                     coupled_plate_flicker_laplacian coupled_plate_flicker_near_bodies
                      PROPERTIES TIMEOUT 300 LABELS validation)
 
 # The same plate at 3 mm to 0.75 s, through the run-up's collapse onto the

@@ -1016,6 +1016,84 @@ static void test_divergence_stencil(void)
     fluid_destroy(&f);
 }
 
+/* fluid.divergence_stencil = near_bodies (the default): a rigid plate two
+ * particles thick in the 6 mm tank of cases/hard_plate_at_rest, a velocity
+ * field with a divergence, a rotation and a disordered part. The rows that
+ * reach a solid particle within re_lap (and the plate's own rows) must hold
+ * Eq. 10 over the Laplacian's neighbours (mps_ops_divergence at re_lap, n0 at
+ * re_lap); the others Eq. 10 at re_n as fluid.c leaves it (the walls
+ * slipping), untouched by the assembly. */
+static void test_divergence_near_bodies(void)
+{
+    const double dp = 0.006;
+    enum { NX = 2, NY = 14 };
+    int id[NX * NY];
+    double xs[NX * NY][MPS_DIM], vsol[NX * NY][MPS_DIM] = {{0}};
+    unsigned char surf[NX * NY];
+    plate_lattice(0.294, dp, NX, NY, 0, id, xs, surf);
+    const char *sets[] = {"dp=0.006"};
+    struct fluid *f = make("cases/hard_plate_at_rest/case.yml", sets, 1);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    struct mps_err err = {0};
+    CHECK(fluid_set_solid(f, NX * NY, id, (const double(*)[MPS_DIM])xs,
+                          (const double(*)[MPS_DIM])vsol, surf, &err) == MPS_OK);
+    CHECK(step(f, 1e-3) == MPS_OK);
+    CHECK(f->prm.divergence_near_bodies && !f->prm.divergence_wide);
+    const size_t n = f->ps.n;
+    for (size_t i = 0; i < n; i++) {
+        double x = f->x[i][0], y = f->x[i][1];
+        f->vstar[i][0] = 0.7 * x + 0.3 * y + 0.01 * sin(1e3 * x * y + (double)i);
+        f->vstar[i][1] = -0.2 * x + 0.4 * y + 0.01 * cos(7e2 * x + (double)i);
+    }
+    double *narrow = calloc(n, sizeof *narrow), *wide = calloc(n, sizeof *wide);
+    CHECK(narrow && wide);
+    if (!narrow || !wide) {
+        free(narrow);
+        free(wide);
+        fluid_destroy(&f);
+        return;
+    }
+    fluid_divergence_slip_walls(f, f->unknown);
+    memcpy(narrow, f->div, n * sizeof *narrow);
+    const struct fluid_params *p = &f->prm;
+    struct mps_ops_in in = {&f->nl, (const double(*)[MPS_DIM])f->x, p->re_lap * p->dp, NULL,
+                            f->unknown, NULL};
+    mps_ops_divergence(&in, f->n0_lap, (const double(*)[MPS_DIM])f->vstar, wide);
+    CHECK(fluid_ppe_assemble(f, 1e-3, &err) == MPS_OK);
+    const double re2 = pow(p->re_lap * p->dp, 2);
+    int near = 0, far = 0, near_differs = 0;
+    double worst_near = 0.0, big = 0.0;
+    int far_changed = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (f->row[i] < 0)
+            continue;
+        int reaches = i >= f->nfixed_end;
+        for (size_t j = f->nfixed_end; j < n && !reaches; j++) {
+            double dx = f->x[j][0] - f->x[i][0], dy = f->x[j][1] - f->x[i][1];
+            reaches = dx * dx + dy * dy < re2;
+        }
+        big = fmax(big, fabs(wide[i]));
+        if (reaches) {
+            near++;
+            worst_near = fmax(worst_near, fabs(f->div[i] - wide[i]));
+            near_differs += fabs(wide[i] - narrow[i]) > 0.05;
+        } else {
+            far++;
+            far_changed += f->div[i] != narrow[i];
+        }
+    }
+    printf("Eq. 10 near bodies: %d rows on the Laplacian's stencil (|diff| <= %.3g of %.3g, "
+           "%d of them away from the gradient's by > 0.05 1/s), %d on the gradient's (%d changed)\n",
+           near, worst_near, big, near_differs, far, far_changed);
+    CHECK(near > 40 && far > 100 && big > 0.5);
+    CHECK(worst_near <= 1e-12 * big && far_changed == 0 && near_differs > 10);
+    free(narrow);
+    free(wide);
+    fluid_destroy(&f);
+}
+
 /* fluid.divergence_walls = slip: still water in the 10 mm tank moved as a
  * whole along the floor, v* = (0.5, 0) m/s for the fluid, the tank at rest.
  * The fluid is moved 0.3 dp along the floor off the wall's lattice. With the
@@ -1094,6 +1172,7 @@ int main(int argc, char **argv)
     test_verlet_list();
     test_surface_double_check();
     test_body_shadow();
+    test_divergence_near_bodies();
     test_tank_corners();
     test_guard_log();
     test_side_walls();
