@@ -217,6 +217,28 @@ static int row_weights(struct fluid *f, size_t i, double c, int wide, double *di
  * corrected at the paper's rate, so the volume drifts by at most about the
  * band. Soft, not a cut-off, so that the source stays continuous in the
  * error (a cut-off would kick a particle whose error crosses the band). */
+/* Eq. 10's sum over row i's kept Laplacian pairs (wcol, wlap of pass 1):
+ * sum_j c w_ij (v*_j - v*_i).r_ij / r_ij^2. A second sweep of the row's
+ * pairs, taken only by the rows that need it (fluid.divergence_stencil). */
+static double row_divergence_sum(const struct fluid *f, size_t i)
+{
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
+    const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
+    const size_t k0 = f->nl.start[i];
+    double dsum = 0.0;
+    for (size_t k = k0; k < k0 + (size_t)f->nwlap[i]; k++) {
+        const int j = f->wcol[k];
+        double r2 = 0.0, dv = 0.0;
+        for (int d = 0; d < MPS_DIM; d++) {
+            double dx = x[j][d] - x[i][d];
+            r2 += dx * dx;
+            dv += (vs[j][d] - vs[i][d]) * dx;
+        }
+        dsum += r2 > 0.0 ? f->wlap[k] * dv / r2 : 0.0;
+    }
+    return dsum;
+}
+
 static double dead_band(double dn, double band)
 {
     return dn > band ? dn - band : dn < -band ? dn + band : 0.0;
@@ -307,8 +329,6 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
      * go unstable (docs/pressure.md, "The divergence near bodies"). */
     const int div_near = mixed && p->divergence_near_bodies && n > f->nfixed_end;
     const double div_norm = MPS_DIM / (c * f->n0_lap);
-    const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
-    const double(*xs)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
 
     /* pass 1: weights, and entries per row (+1 for the diagonal); the
      * diagonal sum goes to rhs temporarily */
@@ -346,21 +366,12 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         int *cols = f->col + s;
         double *vals = f->val + s, diag = f->rhs[r];
         int q = 1;
-        double ghost = 0.0, dsum = 0.0;
+        double ghost = 0.0;
         int body = div_near && i >= f->nfixed_end;
         const size_t k0 = f->nl.start[i];
         for (size_t k = k0; k < k0 + (size_t)f->nwlap[i]; k++) {
             int j = f->wcol[k];
             body |= div_near && (size_t)j >= f->nfixed_end;
-            if (div_wide || div_near) {
-                double r2 = 0.0, dv = 0.0;
-                for (int d = 0; d < MPS_DIM; d++) {
-                    double dx = xs[j][d] - xs[i][d];
-                    r2 += dx * dx;
-                    dv += (vs[j][d] - vs[i][d]) * dx;
-                }
-                dsum += r2 > 0.0 ? f->wlap[k] * dv / r2 : 0.0;
-            }
             if (f->row[j] >= 0) {
                 cols[q] = f->row[j];
                 vals[q++] = -f->wlap[k];
@@ -385,7 +396,7 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         dn = dead_band(dn, band);
         f->rhs[r] = ghost + src * dn;
         if (div_wide || body)
-            f->div[i] = div_norm * dsum;
+            f->div[i] = div_norm * row_divergence_sum(f, i);
         if (mixed) /* with Neumann walls compressibility acts on the change of
                     * pressure, see fluid_ppe.h */
             f->rhs[r] += (ghosts ? comp * f->p[i] : 0.0) - f->div[i] * div_coef;

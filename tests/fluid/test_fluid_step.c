@@ -639,7 +639,10 @@ static int shadow_cross_entries(const struct fluid *f, int *asym)
     return cross;
 }
 
-static void test_body_shadow(void)
+/* cases/hard_plate_at_rest at dp = 6 mm (sets[0] must say so) with a
+ * rigid plate two particles thick at rest in it (x 0.294-0.306 m, 14 rows),
+ * one step of 1 ms taken. NULL (and a failed check) if any of it fails. */
+static struct fluid *plate_at_rest_6mm(const char **sets, int nsets)
 {
     const double dp = 0.006;
     enum { NX = 2, NY = 14 };
@@ -647,16 +650,30 @@ static void test_body_shadow(void)
     double xs[NX * NY][MPS_DIM], vs[NX * NY][MPS_DIM] = {{0}};
     unsigned char surf[NX * NY];
     plate_lattice(0.294, dp, NX, NY, 0, id, xs, surf);
+    struct fluid *f = make("cases/hard_plate_at_rest/case.yml", sets, nsets);
+    CHECK(f != NULL);
+    if (!f)
+        return NULL;
+    struct mps_err err = {0};
+    int ok = fluid_set_solid(f, NX * NY, id, (const double(*)[MPS_DIM])xs,
+                             (const double(*)[MPS_DIM])vs, surf, &err) == MPS_OK;
+    CHECK(ok);
+    ok = ok && step(f, 1e-3) == MPS_OK;
+    CHECK(ok);
+    if (!ok)
+        fluid_destroy(&f);
+    return f;
+}
+
+static void test_body_shadow(void)
+{
+    const double dp = 0.006;
     for (int shadow = 1; shadow >= 0; shadow--) {
         const char *sets[] = {"dp=0.006", shadow ? "fluid.body_shadow=true" : "fluid.body_shadow=false"};
-        struct fluid *f = make("cases/hard_plate_at_rest/case.yml", sets, 2);
-        CHECK(f != NULL);
+        struct fluid *f = plate_at_rest_6mm(sets, 2);
         if (!f)
             continue;
         struct mps_err err = {0};
-        CHECK(fluid_set_solid(f, NX * NY, id, (const double(*)[MPS_DIM])xs,
-                              (const double(*)[MPS_DIM])vs, surf, &err) == MPS_OK);
-        CHECK(step(f, 1e-3) == MPS_OK);
         CHECK(fluid_ppe_assemble(f, 1e-3, &err) == MPS_OK);
         int asym = 0, cross = shadow_cross_entries(f, &asym);
         printf("body_shadow %d: %d PPE entries across the plate, %d not symmetric\n", shadow,
@@ -1025,21 +1042,11 @@ static void test_divergence_stencil(void)
  * slipping), untouched by the assembly. */
 static void test_divergence_near_bodies(void)
 {
-    const double dp = 0.006;
-    enum { NX = 2, NY = 14 };
-    int id[NX * NY];
-    double xs[NX * NY][MPS_DIM], vsol[NX * NY][MPS_DIM] = {{0}};
-    unsigned char surf[NX * NY];
-    plate_lattice(0.294, dp, NX, NY, 0, id, xs, surf);
     const char *sets[] = {"dp=0.006"};
-    struct fluid *f = make("cases/hard_plate_at_rest/case.yml", sets, 1);
-    CHECK(f != NULL);
+    struct fluid *f = plate_at_rest_6mm(sets, 1);
     if (!f)
         return;
     struct mps_err err = {0};
-    CHECK(fluid_set_solid(f, NX * NY, id, (const double(*)[MPS_DIM])xs,
-                          (const double(*)[MPS_DIM])vsol, surf, &err) == MPS_OK);
-    CHECK(step(f, 1e-3) == MPS_OK);
     CHECK(f->prm.divergence_near_bodies && !f->prm.divergence_wide);
     const size_t n = f->ps.n;
     for (size_t i = 0; i < n; i++) {
