@@ -9,7 +9,8 @@ Prints the share of the 2 ms force rows within 15% of their 20 ms running mean
 and the RMS of the deviation (tests/coupler/check_plate_flicker.py) for each
 realisation, their mean, and the same for the mean force of the realisations
 (each interpolated to the first one's row times: a row is written at the
-first step that reaches its time).
+first step that reaches its time), with that mean force's largest and
+smallest row.
 That mean keeps what the realisations share (the impacts, the flow's own
 transients a 20 ms mean cannot follow) and averages away most of their
 independent noise, so its share is about what a run without noise could reach."""
@@ -42,9 +43,12 @@ def main():
         print('%s: within 15%% %.1f%%, RMS deviation %.2f N/m' % (r, 100 * m['within15'], m['rms_dev']))
     print('each run: within 15%% %.1f%% (mean), RMS deviation %.2f N/m' % (
         100 * np.mean([m['within15'] for m in each]), np.mean([m['rms_dev'] for m in each])))
-    em = force_series_smoothness(t, forces.mean(axis=0))
-    print('mean force of the %d runs: within 15%% %.1f%%, RMS deviation %.2f N/m' % (
-        len(runs), 100 * em['within15'], em['rms_dev']))
+    mean = forces.mean(axis=0)
+    em = force_series_smoothness(t, mean)
+    print('mean force of the %d runs: within 15%% %.1f%%, RMS deviation %.2f N/m; largest '
+          '%.0f N/m at %.3f s, smallest %.0f N/m at %.3f s' % (
+              len(runs), 100 * em['within15'], em['rms_dev'], mean.max(), t[mean.argmax()],
+              mean.min(), t[mean.argmin()]))
 
 
 if __name__ == '__main__':
