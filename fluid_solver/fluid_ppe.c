@@ -207,16 +207,6 @@ static int row_weights(struct fluid *f, size_t i, double c, int wide, double *di
     return m;
 }
 
-/* fluid.density_dead_band: the density error less the band, 0 inside it.
- * Errors of a few hundredths of a percent are the lattice's own noise (a
- * square lattice jittered by 0.02 dp reads +0.08%); corrected at the paper's rate
- * they feed a lattice-scale mode that sets still water moving after 2-3 s
- * at 1 ms steps and within a second at 0.2 ms, pairs its particles up and
- * expands it 2.4% (docs/pressure.md). Without a correction inside the band
- * that mode has nothing to grow from; beyond it the error's excess is
- * corrected at the paper's rate, so the volume drifts by at most about the
- * band. Soft, not a cut-off, so that the source stays continuous in the
- * error (a cut-off would kick a particle whose error crosses the band). */
 /* Eq. 10's sum over row i's kept Laplacian pairs (wcol, wlap of pass 1):
  * sum_j c w_ij (v*_j - v*_i).r_ij / r_ij^2. A second sweep of the row's
  * pairs, taken only by the rows that need it (fluid.divergence_stencil). */
@@ -239,6 +229,16 @@ static double row_divergence_sum(const struct fluid *f, size_t i)
     return dsum;
 }
 
+/* fluid.density_dead_band: the density error less the band, 0 inside it.
+ * Errors of a few hundredths of a percent are the lattice's own noise (a
+ * square lattice jittered by 0.02 dp reads +0.08%); corrected at the paper's rate
+ * they feed a lattice-scale mode that sets still water moving after 2-3 s
+ * at 1 ms steps and within a second at 0.2 ms, pairs its particles up and
+ * expands it 2.4% (docs/pressure.md). Without a correction inside the band
+ * that mode has nothing to grow from; beyond it the error's excess is
+ * corrected at the paper's rate, so the volume drifts by at most about the
+ * band. Soft, not a cut-off, so that the source stays continuous in the
+ * error (a cut-off would kick a particle whose error crosses the band). */
 static double dead_band(double dn, double band)
 {
     return dn > band ? dn - band : dn < -band ? dn + band : 0.0;
