@@ -3,6 +3,8 @@
 (docs/pressure.md, "The deep patches at P = 0, and the water's area").
 
 usage: bench/interior_zero.py RUN [RUN ...] --dp DP [--after 0.05] [--deep 3]
+                              [--pool XMAX YMAX] [--picture PNG --times T ...
+                               [--box X0 X1 Y0 Y1]]
 
 For each fluid snapshot of each RUN after `--after` s: the share of the
 interior fluid (type 0, not on the free surface) at P = 0, split by the
@@ -16,6 +18,18 @@ lattice's area per particle). Particles near the surface are left out of the
 mean: their cells reach into the air or are cut by it.
 With several RUNs (realisations of one setting) a last block gives the
 mean over the runs of each column at each snapshot index.
+--pool XMAX YMAX: a last column, the share at P = 0 of the interior fluid in
+the box x < XMAX, y < YMAX (the dam break on a plate: the pool upstream of
+the plate's face and below its top, the water that loads the plate before
+any overtops it), and a closing count over all snapshots of all RUNs: the
+snapshots with more than 5% of the interior at P = 0, counting all of it,
+only what lies 1.5 dp or more from the free surface, and only the pool; and
+the share of all the interior particles at P = 0 that lie outside the pool
+(docs/pressure.md, "Where the plate's interior at P = 0 is").
+--picture PNG --times T ...: draws the first RUN's snapshots nearest to each
+T: the fluid, its free-surface particles grey, the interior at P = 0 red,
+the tank and (from the solid snapshot of that time) the solid black; --box
+sets the frame (default: the fluid's extent).
 Exit 1 if a RUN has no fluid snapshot."""
 import argparse
 import glob
@@ -32,13 +46,15 @@ def polygon_area(v):
     return 0.5 * abs(np.dot(x, np.roll(y, 1)) - np.dot(y, np.roll(x, 1)))
 
 
-def snapshot(fn, dp, deep):
+def read_fluid(fn):
+    """(time, type, pressure, free-surface flag, 2D positions) of a fluid snapshot."""
     with h5py.File(fn, 'r') as f:
-        t = float(f.attrs['time'])
-        ptype = f['particles/type'][:]
-        p = f['particles/pressure'][:]
-        surf = f['particles/free_surface'][:]
-        x = f['particles/position'][:][:, :2]
+        return (float(f.attrs['time']), f['particles/type'][:], f['particles/pressure'][:],
+                f['particles/free_surface'][:], f['particles/position'][:][:, :2])
+
+
+def snapshot(fn, dp, deep, pool=None):
+    t, ptype, p, surf, x = read_fluid(fn)
     fluid = ptype == 0
     interior = np.where(fluid & (surf == 0))[0]
     on_surface = fluid & (surf != 0)
@@ -53,8 +69,67 @@ def snapshot(fn, dp, deep):
         reg = vor.regions[vor.point_region[i]]
         if reg and -1 not in reg:
             areas.append(polygon_area(vor.vertices[reg]) / dp ** 2)
+    extra = None
+    if pool is not None:
+        inside = (x[interior, 0] < pool[0]) & (x[interior, 1] < pool[1])
+        extra = (float(np.mean(zero[inside])) if inside.any() else 0.0,
+                 int(zero.sum()), int((zero & ~inside).sum()))
     return (t, float(zero.mean()), [float(np.mean(zero & b)) for b in bands],
-            float(np.mean(areas)) if areas else float('nan'))
+            float(np.mean(areas)) if areas else float('nan'), extra)
+
+
+def pool_share(fn, pool):
+    """(time, share at P = 0 of the interior fluid in x < pool[0], y < pool[1])."""
+    t, ptype, p, surf, x = read_fluid(fn)
+    inside = (ptype == 0) & (surf == 0) & (x[:, 0] < pool[0]) & (x[:, 1] < pool[1])
+    return t, float(np.mean(p[inside] == 0.0)) if inside.any() else 0.0
+
+
+def solid_positions(run, t):
+    best = None
+    for fn in glob.glob(os.path.join(run, 'solid_*.h5')):
+        with h5py.File(fn, 'r') as f:
+            ts = float(f.attrs['time'])
+            if best is None or abs(ts - t) < best[0]:
+                best = (abs(ts - t), f['particles/position'][:][:, :2])
+    return best[1] if best is not None else np.zeros((0, 2))
+
+
+def picture(run, times, path, box=None):
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    files = sorted(glob.glob(os.path.join(run, 'fluid_*.h5')))
+    stamps = []
+    for fn in files:
+        with h5py.File(fn, 'r') as f:
+            stamps.append(float(f.attrs['time']))
+    cols = 2 if len(times) > 1 else 1
+    rows = (len(times) + cols - 1) // cols
+    fig, axs = plt.subplots(rows, cols, figsize=(7 * cols, 4.2 * rows), squeeze=False)
+    for ax, t in zip(axs.flat, times):
+        fn = files[int(np.argmin(np.abs(np.array(stamps) - t)))]
+        t, ptype, p, surf, x = read_fluid(fn)
+        fluid = ptype == 0
+        zero = fluid & (surf == 0) & (p == 0.0)
+        ax.scatter(x[fluid, 0], x[fluid, 1], s=3, c='lightblue')
+        ax.scatter(x[fluid & (surf != 0), 0], x[fluid & (surf != 0), 1], s=3, c='grey')
+        ax.scatter(x[zero, 0], x[zero, 1], s=7, c='red')
+        ax.scatter(x[~fluid, 0], x[~fluid, 1], s=2, c='black')
+        xs = solid_positions(run, t)
+        ax.scatter(xs[:, 0], xs[:, 1], s=3, c='black')
+        ax.set_title('t = %.3f s: %d of %d interior particles at P = 0'
+                     % (t, zero.sum(), (fluid & (surf == 0)).sum()))
+        ax.set_aspect('equal')
+        if box:
+            ax.set_xlim(box[0], box[1])
+            ax.set_ylim(box[2], box[3])
+        else:
+            lo, hi = x[fluid].min(axis=0), x[fluid].max(axis=0)
+            ax.set_xlim(lo[0] - 0.01, hi[0] + 0.01)
+            ax.set_ylim(lo[1] - 0.01, hi[1] + 0.01)
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
 
 
 def main():
@@ -63,7 +138,16 @@ def main():
     ap.add_argument('--dp', type=float, required=True)
     ap.add_argument('--after', type=float, default=0.05)
     ap.add_argument('--deep', type=float, default=3.0)
+    ap.add_argument('--pool', type=float, nargs=2, metavar=('XMAX', 'YMAX'))
+    ap.add_argument('--picture')
+    ap.add_argument('--times', type=float, nargs='+', default=[])
+    ap.add_argument('--box', type=float, nargs=4, metavar=('X0', 'X1', 'Y0', 'Y1'))
     a = ap.parse_args()
+    if a.picture:
+        if not a.times:
+            ap.error('--picture needs --times')
+        picture(a.runs[0], a.times, a.picture, a.box)
+    counts = {'snapshots': 0, 'all': 0, 'beyond': 0, 'pool': 0, 'zero': 0, 'outside': 0}
     table = []
     print('run, t (s): interior at P = 0 | of it: < 1.5 dp, 1.5-%g dp, > %g dp from the '
           'surface | deep cells\' mean area (dp^2)' % (a.deep, a.deep))
@@ -74,12 +158,22 @@ def main():
             print('interior_zero.py: %s: no fluid snapshot (fluid_*.h5)' % run, file=sys.stderr)
             return 1
         for fn in files:
-            s = snapshot(fn, a.dp, a.deep)
+            s = snapshot(fn, a.dp, a.deep, a.pool)
             if s is None or s[0] <= a.after:
                 continue
             rows.append([s[0], s[1]] + s[2] + [s[3]])
-            print('%s %.4f: %5.1f%% | %5.1f%% %5.1f%% %5.1f%% | %.4f'
-                  % (run, s[0], 100 * s[1], 100 * s[2][0], 100 * s[2][1], 100 * s[2][2], s[3]))
+            tail = ''
+            if s[4] is not None:
+                tail = ' | pool %5.1f%%' % (100 * s[4][0])
+                counts['snapshots'] += 1
+                counts['all'] += s[1] > 0.05
+                counts['beyond'] += s[2][1] + s[2][2] > 0.05
+                counts['pool'] += s[4][0] > 0.05
+                counts['zero'] += s[4][1]
+                counts['outside'] += s[4][2]
+            print('%s %.4f: %5.1f%% | %5.1f%% %5.1f%% %5.1f%% | %.4f%s'
+                  % (run, s[0], 100 * s[1], 100 * s[2][0], 100 * s[2][1], 100 * s[2][2], s[3],
+                     tail))
         table.append(rows)
     if len(table) > 1:
         k = min(len(r) for r in table)
@@ -88,6 +182,13 @@ def main():
         for row in m:
             print('  %.3f: %5.1f%% | %5.1f%% %5.1f%% %5.1f%% | %.4f'
                   % (row[0], 100 * row[1], 100 * row[2], 100 * row[3], 100 * row[4], row[5]))
+    if a.pool is not None:
+        c = counts
+        print('snapshots over 5%%, of %d: %d of the interior, %d counting only the fluid 1.5 dp or '
+              'more from the surface, %d in the pool; of the %d interior particles at P = 0, '
+              '%.1f%% outside the pool'
+              % (c['snapshots'], c['all'], c['beyond'], c['pool'], c['zero'],
+                 100.0 * c['outside'] / max(c['zero'], 1)))
     return 0
 
 
