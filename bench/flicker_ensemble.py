@@ -28,7 +28,7 @@ Runs already in OUT (a summary.json) are reused. --set goes to every run.
 if any realisation has a snapshot after 0.05 s with more than PERCENT of its
 interior fluid at P = 0 (the issue's target is 5), each realisation's worst
 snapshot printed."""
-import argparse, json, os, subprocess, sys, tempfile
+import argparse, glob, json, os, subprocess, sys, tempfile
 
 import numpy as np
 
@@ -38,7 +38,6 @@ sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'fluid'))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'coupler'))
 import check_flicker  # noqa: E402
-import glob  # noqa: E402
 from interior_zero import pool_share  # noqa: E402
 import plate_compare as pc  # noqa: E402
 from check_plate_flicker import force_smoothness  # noqa: E402

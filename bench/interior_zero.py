@@ -53,6 +53,11 @@ def read_fluid(fn):
                 f['particles/free_surface'][:], f['particles/position'][:][:, :2])
 
 
+def in_pool(x, pool):
+    """Positions x inside the box x < pool[0], y < pool[1]."""
+    return (x[:, 0] < pool[0]) & (x[:, 1] < pool[1])
+
+
 def snapshot(fn, dp, deep, pool=None):
     t, ptype, p, surf, x = read_fluid(fn)
     fluid = ptype == 0
@@ -71,7 +76,7 @@ def snapshot(fn, dp, deep, pool=None):
             areas.append(polygon_area(vor.vertices[reg]) / dp ** 2)
     extra = None
     if pool is not None:
-        inside = (x[interior, 0] < pool[0]) & (x[interior, 1] < pool[1])
+        inside = in_pool(x[interior], pool)
         extra = (float(np.mean(zero[inside])) if inside.any() else 0.0,
                  int(zero.sum()), int((zero & ~inside).sum()))
     return (t, float(zero.mean()), [float(np.mean(zero & b)) for b in bands],
@@ -81,7 +86,7 @@ def snapshot(fn, dp, deep, pool=None):
 def pool_share(fn, pool):
     """(time, share at P = 0 of the interior fluid in x < pool[0], y < pool[1])."""
     t, ptype, p, surf, x = read_fluid(fn)
-    inside = (ptype == 0) & (surf == 0) & (x[:, 0] < pool[0]) & (x[:, 1] < pool[1])
+    inside = (ptype == 0) & (surf == 0) & in_pool(x, pool)
     return t, float(np.mean(p[inside] == 0.0)) if inside.any() else 0.0
 
 
