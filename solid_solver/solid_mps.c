@@ -219,7 +219,7 @@ enum mps_status solid_mps_create(struct solid_mps **out, const struct solid_scen
     for (int b = 0; b < scene->nbodies; b++) {
         struct solid_mps_material *m = &s->mat[b];
         m->rho = scene->bodies[b].rho;
-        m->E = scene->bodies[b].E;
+        m->E = solid_scene_modulus(scene, b);
         m->nu = scene->bodies[b].nu;
         solid_scene_lame(scene, b, &m->lambda, &m->mu);
         m->wave_speed = sqrt((m->lambda + 2.0 * m->mu) / m->rho);
@@ -607,6 +607,7 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_num(j, "dt_stable", solid_mps_stable_dt(s));
     mps_json_num(j, "courant", s->courant);
     mps_json_str(j, "plane", s->scene.plane == SOLID_PLANE_STRAIN ? "strain" : "stress");
+    mps_json_num(j, "plane_factor", s->scene.plane_factor);
     struct solid_mps_diag d;
     solid_mps_diag(s, &d);
     mps_json_object(j, "final");

@@ -32,6 +32,10 @@ const struct mps_key_spec solid_case_keys[] = {
      "fraction of the stable explicit step, in (0, 1]"},
     {"solid.plane", MPS_KEY_ENUM, "strain", 0, 0, 0, "strain|stress", "",
      "2D Lame constants: plane strain (Eq. 4 as printed) or plane stress"},
+    {"solid.plane_factor", MPS_KEY_DOUBLE, "1", 0, 2, MPS_KEY_LO_OPEN, NULL, "",
+     "factor on E in 2D: the bending stiffness of the 3D body over that of the plane chosen, "
+     "for a strip whose breadth and clamp put it between the planes "
+     "(bench/plate_3d_stiffness.py); 1 = the plane as it is"},
     {"solid.interface_depth", MPS_KEY_DOUBLE, "2.1", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
      "dp", "inner particles within this depth of the surface are sent to a coupled fluid (its "
      "number-density radius)"},
@@ -111,9 +115,15 @@ void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
         *nx = *ny = 0;
 }
 
+double solid_scene_modulus(const struct solid_scene *s, int b)
+{
+    /* a scene built by hand (tests) may leave the factor 0: none */
+    return s->bodies[b].E * (s->plane_factor > 0.0 ? s->plane_factor : 1.0);
+}
+
 void solid_scene_lame(const struct solid_scene *s, int b, double *lambda, double *mu)
 {
-    double E = s->bodies[b].E, nu = s->bodies[b].nu;
+    double E = solid_scene_modulus(s, b), nu = s->bodies[b].nu;
     *mu = E / (2.0 * (1.0 + nu)); /* Eq. 4 */
     if (s->plane == SOLID_PLANE_STRAIN)
         *lambda = E * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)); /* Eq. 4 */
@@ -168,6 +178,7 @@ enum mps_status solid_scene_read(struct solid_scene *s, const struct mps_case *c
     s->mps_damping = mps_case_double(c, "solid.mps.damping");
     s->plane = strcmp(mps_case_string(c, "solid.plane"), "strain") == 0 ? SOLID_PLANE_STRAIN
                                                                           : SOLID_PLANE_STRESS;
+    s->plane_factor = mps_case_double(c, "solid.plane_factor");
     s->eps_max = mps_case_has(c, "solid.eps_max") ? mps_case_double(c, "solid.eps_max") : 0.0;
     s->contact = s->eps_max > 0.0 ? SOLID_CONTACT_ALL : SOLID_CONTACT_NONE;
     if (mps_case_has(c, "solid.contact")) {

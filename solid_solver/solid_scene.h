@@ -74,6 +74,8 @@ struct solid_scene {
     double courant;          /* (0, 1]: fraction of the stable step, see solid_mps.h */
     double mps_damping;      /* MPS solid: damping ratio at the spin frequency (solid_mps.h) */
     enum solid_plane plane;
+    double plane_factor;     /* solid.plane_factor: on E, the 3D body's bending stiffness
+                              * over the plane's (0 in a scene built by hand: 1) */
     double eps_max;          /* bond breaking strain (Eq. 47); 0: no fracture */
     enum solid_contact contact;
     int nbodies, nclamps, nprobes;
@@ -128,7 +130,12 @@ enum mps_status solid_loads_accel(const struct solid_scene *s, const int *body, 
  * refine x refine particles and the body keeps the extent it has at dp. */
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny);
 
-/* Lame constants of body b, Pa (Eq. 4, or plane stress, see enum solid_plane). */
+/* Young's modulus of body b as the 2D model uses it, Pa: E times
+ * solid.plane_factor. */
+double solid_scene_modulus(const struct solid_scene *s, int b);
+
+/* Lame constants of body b, Pa (Eq. 4, or plane stress, see enum solid_plane),
+ * from solid_scene_modulus. */
 void solid_scene_lame(const struct solid_scene *s, int b, double *lambda, double *mu);
 
 #endif

@@ -307,7 +307,7 @@ enum mps_status solid_tlsph_create(struct solid_tlsph **out, const struct solid_
     for (int b = 0; b < scene->nbodies; b++) {
         struct solid_tlsph_material *m = &s->mat[b];
         m->rho = scene->bodies[b].rho;
-        m->E = scene->bodies[b].E;
+        m->E = solid_scene_modulus(scene, b);
         m->nu = scene->bodies[b].nu;
         solid_scene_lame(scene, b, &m->lambda, &m->mu);
         m->wave_speed = sqrt((m->lambda + 2.0 * m->mu) / m->rho);
@@ -725,6 +725,7 @@ static void op_summary(const void *self, struct mps_json *j)
     mps_json_num(j, "hourglass", s->hourglass);
     mps_json_str(j, "correction", s->quadratic ? "quadratic" : "linear");
     mps_json_str(j, "plane", s->scene.plane == SOLID_PLANE_STRAIN ? "strain" : "stress");
+    mps_json_num(j, "plane_factor", s->scene.plane_factor);
     struct solid_tlsph_diag d;
     solid_tlsph_diag(s, &d);
     mps_json_object(j, "final");

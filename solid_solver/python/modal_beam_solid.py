@@ -87,6 +87,9 @@ class Beam:
             case.fail(f'{b}.y1', f'must be > y0 = {y0:g}')
         rho = case.number(f'{b}.rho', lo=0.0, lo_open=True)
         E = case.number(f'{b}.E', lo=0.0, lo_open=True)
+        # the 3D strip's bending stiffness over the 2D plane's (solid.plane_factor,
+        # as the C solids read it)
+        E *= case.number('solid.plane_factor', 1.0, lo=0.0, lo_open=True, hi=2.0)
         clamp_tops = [case.number(f'solid.clamps.{k}.y1') for k in range(case.count('solid.clamps'))]
         root = max(clamp_tops + [y0])
         if root >= y1:

@@ -3,7 +3,7 @@
 probes.csv (column tip_dy, m), compared with Eq. 53-54.
 
 usage: cantilever_check.py PROBES.csv [--freq-tol PCT] [--defl-max PCT] [--defl-min PCT]
-                           [--min-periods N]
+                           [--min-periods N] [--modulus-factor F]
 Prints one JSON line {f, f_err_pct, dmax_cm, disc_pct, periods}; with
 tolerances given, exits 1 when a figure is outside them."""
 import argparse
@@ -27,12 +27,14 @@ def crossings(t, y, direction):
     return np.array([t[i] - y[i] * (t[i + 1] - t[i]) / (y[i + 1] - y[i]) for i in idx])
 
 
-def analyse(path):
+def analyse(path, factor=1.0):
     with open(path) as f:  # '#' lines: the run's provenance
         data = np.genfromtxt((l for l in f if not l.startswith("#")), delimiter=",", names=True)
     t, dy = data["time"], data["tip_dy"]
     if not np.all(np.isfinite(dy)):
         raise SystemExit(f"{path}: non-finite tip_dy")
+    # solid.plane_factor multiplies E: the frequency goes as its root, the deflection inversely
+    f_ref, d_ref = F_REF * math.sqrt(factor), D_REF / factor
     y = dy - 0.5 * (dy.max() + dy.min())
     periods = []
     for direction in (-1, 1):
@@ -44,12 +46,12 @@ def analyse(path):
     dmax = float(np.max(np.abs(dy)))
     return {
         "f": f,
-        "f_err_pct": 100.0 * (f - F_REF) / F_REF,
+        "f_err_pct": 100.0 * (f - f_ref) / f_ref,
         "dmax_cm": 100.0 * dmax,
-        "disc_pct": 100.0 * (D_REF - dmax) / D_REF,
+        "disc_pct": 100.0 * (d_ref - dmax) / d_ref,
         "periods": t[-1] * f,
-        "f_ref": F_REF,
-        "dmax_ref_cm": 100.0 * D_REF,
+        "f_ref": f_ref,
+        "dmax_ref_cm": 100.0 * d_ref,
     }
 
 
@@ -62,15 +64,17 @@ def main():
     ap.add_argument("--defl-max", type=float, help="max deflection discrepancy, percent")
     ap.add_argument("--defl-min", type=float, help="min deflection discrepancy, percent")
     ap.add_argument("--min-periods", type=float, help="min number of periods simulated")
+    ap.add_argument("--modulus-factor", type=float, default=1.0,
+                    help="the run's solid.plane_factor: E in the references times this")
     a = ap.parse_args()
-    r = analyse(a.probes)
+    r = analyse(a.probes, a.modulus_factor)
     print(json.dumps(r))
     bad = []
     if a.freq_tol is not None and abs(r["f_err_pct"]) > a.freq_tol:
-        bad.append(f"f = {r['f']:.4f} Hz is {r['f_err_pct']:+.2f}% off {F_REF:.4f} Hz "
+        bad.append(f"f = {r['f']:.4f} Hz is {r['f_err_pct']:+.2f}% off {r['f_ref']:.4f} Hz "
                    f"(tolerance {a.freq_tol}%)")
     if a.freq_range and not a.freq_range[0] <= r["f_err_pct"] <= a.freq_range[1]:
-        bad.append(f"f = {r['f']:.4f} Hz is {r['f_err_pct']:+.2f}% off {F_REF:.4f} Hz "
+        bad.append(f"f = {r['f']:.4f} Hz is {r['f_err_pct']:+.2f}% off {r['f_ref']:.4f} Hz "
                    f"(allowed {a.freq_range[0]:+g}% to {a.freq_range[1]:+g}%)")
     if a.defl_max is not None and r["disc_pct"] > a.defl_max:
         bad.append(f"max deflection {r['dmax_cm']:.2f} cm: discrepancy {r['disc_pct']:.2f}% "
