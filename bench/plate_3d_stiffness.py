@@ -183,6 +183,8 @@ class Plate:
     def solve(self, q, u0=None, steps=1):
         """Static equilibrium under pressure q (Pa), from u0 in load steps."""
         u = np.zeros(self.ndof) if u0 is None else u0.copy()
+        if u0 is None:
+            self.path = [(0.0, 0.0)]   # (load, tip) at each load step from rest
         q0 = 0.0 if u0 is None else self._q
         for s in range(1, steps + 1):
             ql = q0 + (q - q0) * s / steps
@@ -198,6 +200,7 @@ class Plate:
                     break
             else:
                 raise RuntimeError(f'{self.kind}: Newton did not converge at q = {ql:.3g} Pa')
+            self.path.append((ql, self.tip_dx(u)))
         self._q = q
         return u
 
@@ -227,10 +230,16 @@ STRIP = 0.25e-3   # m: the 'stress' body's breadth, a sixteenth of the thickness
 
 
 def stiffness_factors(length, crest, mesh, small=1e-4, linear_only=False,
-                      bodies=('stress', 'real', 'strain')):
-    """{body: (q at the small tip, q at the crest, wall s)} and the factors
-    {body: (f small, f crest)} against the 'stress' body (which bodies must
-    hold); mesh (nt, nb, nl). linear_only: the crest is not solved (None)."""
+                      bodies=('stress', 'real', 'strain'), energy=True):
+    """{body: (q at the small tip, q at the crest, k of a swing to the crest,
+    wall s)} and the factors {body: (f small, f crest, f swing)} against the
+    'stress' body (which bodies must hold); mesh (nt, nb, nl). f crest
+    compares the loads that hold the tip at the crest (secant stiffness),
+    f swing the describing functions of a harmonic swing to the crest (the
+    linear stiffness with the same first harmonic: for a cubic spring
+    k1 + 3/4 k3 A^2, three quarters of the way from the small tip's to the
+    secant's). linear_only: the crest is not solved (None); energy=False: nor
+    the swing (None)."""
     res = {}
     for kind in bodies:
         t0 = time.time()
@@ -240,10 +249,23 @@ def stiffness_factors(length, crest, mesh, small=1e-4, linear_only=False,
         # Euler-Bernoulli in plane stress for a first guess: q L^4 / (8 E I)
         qg = lambda d: d * 8 * E_RUBBER * THICK ** 3 / 12 / length ** 4
         ql, _ = load_for(plate, small, qg(small))
-        qc = None if linear_only else load_for(plate, crest, qg(crest))[0]
-        res[kind] = (ql, qc, time.time() - t0)
+        qc = wc = None
+        if not linear_only:
+            qc = load_for(plate, crest, qg(crest))[0]
+        if not linear_only and energy:
+            # the load path from rest to the crest's load, in 16 steps
+            plate.solve(qc, None, steps=16)
+            q, d = np.array(plate.path).T
+            # the describing function: the first harmonic of the load over a
+            # swing A cos(theta) (the plate's swing is close to a sinusoid),
+            # k = (4 / (pi A)) int_0^(pi/2) q(A cos theta) cos theta dtheta
+            th = np.linspace(0.0, np.pi / 2, 401)
+            g = np.interp(d[-1] * np.cos(th), d, q) * np.cos(th)
+            wc = float(4.0 / (np.pi * d[-1]) * np.sum(0.5 * (g[1:] + g[:-1]) * np.diff(th)))
+        res[kind] = (ql, qc, wc, time.time() - t0)
     s = res['stress']
-    f = {k: (v[0] / s[0], None if linear_only else v[1] / s[1]) for k, v in res.items()}
+    f = {k: (v[0] / s[0], None if qc is None else v[1] / s[1],
+             None if wc is None else v[2] / s[2]) for k, v in res.items()}
     return res, f
 
 
@@ -257,9 +279,10 @@ def main():
     ap.add_argument('--small', type=float, default=1e-4,
                     help='the "linear" tip deflection, m')
     args = ap.parse_args()
-    print('| filling | body | mesh (t, b/2, L) | f at a tip of %.2g mm (linear) | crest | f there | wall s |'
+    print('| filling | body | mesh (t, b/2, L) | f at a tip of %.2g mm (linear) | crest '
+          '| f there (secant) | f of a swing to the crest (describing function) | wall s |'
           % (args.small * 1e3))
-    print('|---|---|---|---|---|---|---|')
+    print('|---|---|---|---|---|---|---|---|')
     for name in args.fillings:
         length, crest = FILLINGS[name]
         nl = args.mesh[2] or int(round(length / 0.0029))
@@ -267,7 +290,8 @@ def main():
         for kind in ('stress', 'real', 'strain'):
             nb = 1 if kind == 'stress' else args.mesh[1]
             print(f'| {name} | {kind} | {args.mesh[0]}, {nb}, {nl} | {f[kind][0]:.3f} '
-                  f'| {crest * 100:.2f} cm | {f[kind][1]:.3f} | {res[kind][2]:.0f} |', flush=True)
+                  f'| {crest * 100:.2f} cm | {f[kind][1]:.3f} | {f[kind][2]:.3f} '
+                  f'| {res[kind][3]:.0f} |', flush=True)
         eb = args.small * 8 * E_RUBBER * THICK ** 3 / 12 / length ** 4
         print(f'{name}: the stress body takes {res["stress"][0]:.4g} Pa for the small tip, '
               f'Euler-Bernoulli {eb:.4g} Pa', file=sys.stderr)

@@ -63,8 +63,9 @@ def planes():
 
 def ashwell():
     length, crest = p3.FILLINGS['high']
-    _, f = p3.stiffness_factors(length, crest, (1, 2, 20), bodies=('stress', 'real'))
-    lin, cr = f['real']
+    _, f = p3.stiffness_factors(length, crest, (1, 2, 20), bodies=('stress', 'real'),
+                                 energy=False)
+    lin, cr, _ = f['real']
     return check('crest', cr / lin > 1.03,
                  f'the high plate {lin:.4f} times plane stress at a small tip, {cr:.4f} '
                  f'at {crest * 100:.2f} cm ({cr / lin:.3f}, must exceed 1.03)')
