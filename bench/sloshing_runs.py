@@ -75,7 +75,9 @@ def run_list():
             # (solid_tlsph.c refuses 2): at 2 mm the linear correction
             lin = ['solid.tlsph.correction=linear'] if model == 'tlsph' else []
             r[f'{case}_2_{model}'] = (case, ['dp=0.002'] + pics + COARSE + lin, solid)
+            # plane strain as it is, without the cases' 3D factor on plane stress
             r[f'{case}_2_{model}_strain'] = (case, ['dp=0.002', 'solid.plane=strain',
+                                                    'solid.plane_factor=1',
                                                     'solid.courant=0.75'] + COARSE + lin, solid)
             r[f'{case}_1_{model}'] = (case, pics + EXPLICIT, solid)
             r[f'{case}_0.8_{model}'] = (case, ['dp=0.0008'] + EXPLICIT, solid)
