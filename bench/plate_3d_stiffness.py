@@ -32,6 +32,8 @@ import time
 
 import numpy as np
 
+import plate_fe  # the 1-D quadratic shape functions and the Gauss rule of the 2D reference
+
 try:  # scipy's sparse LU where it is there; numpy's dense solve (as on CI) otherwise
     import scipy.sparse as sp
     import scipy.sparse.linalg as spla
@@ -47,49 +49,23 @@ BREADTH = 0.039      # m, the tank's breadth (docs/sloshing.md, "Side walls")
 # high filling; the low one's 1.44 cm peak to peak
 FILLINGS = {'high': (0.1148, 0.0745), 'low': (0.0574, 0.0072)}
 
-G1 = np.array([-np.sqrt(0.6), 0.0, np.sqrt(0.6)])
-W1 = np.array([5.0, 8.0, 5.0]) / 9.0
-
-
-def lagrange_1d(s):
-    """Quadratic Lagrange shape functions on nodes -1, 0, 1 and their derivatives at s."""
-    n = np.array([0.5 * s * (s - 1.0), 1.0 - s * s, 0.5 * s * (s + 1.0)])
-    d = np.array([s - 0.5, -2.0 * s, s + 0.5])
-    return n, d
-
-
 def hex27_tables():
-    """Shape-function derivatives (gp, 27, 3) in the reference cube and the weights (gp)."""
-    dN, w = [], []
-    for a, sa in enumerate(G1):
-        for b, sb in enumerate(G1):
-            for c, sc in enumerate(G1):
-                na, da = lagrange_1d(sa)
-                nb, db = lagrange_1d(sb)
-                nc, dc = lagrange_1d(sc)
-                d = np.empty((27, 3))
-                k = 0
-                for i in range(3):
-                    for j in range(3):
-                        for l in range(3):
-                            d[k] = (da[i] * nb[j] * nc[l], na[i] * db[j] * nc[l],
-                                    na[i] * nb[j] * dc[l])
-                            k += 1
-                dN.append(d)
-                w.append(W1[a] * W1[b] * W1[c])
-    return np.array(dN), np.array(w)
+    """Shape-function derivatives (gp, 27, 3) in the reference cube and the
+    weights (gp): the tensor product of plate_fe's 1-D quadratics, local node
+    9 i + 3 j + l for (x, y, z) indices (i, j, l)."""
+    n, d = plate_fe.lagrange2(plate_fe.GAUSS_X)           # (gp, node)
+    dN = np.stack([np.einsum('ai,bj,cl->abcijl', d, n, n),
+                   np.einsum('ai,bj,cl->abcijl', n, d, n),
+                   np.einsum('ai,bj,cl->abcijl', n, n, d)], axis=-1).reshape(27, 27, 3)
+    W = plate_fe.GAUSS_W
+    return dN, np.einsum('a,b,c->abc', W, W, W).ravel()
 
 
 def quad9_tables():
     """Face shape functions (gp, 9) and weights on the reference square."""
-    N, w = [], []
-    for a, sa in enumerate(G1):
-        for b, sb in enumerate(G1):
-            na, _ = lagrange_1d(sa)
-            nb, _ = lagrange_1d(sb)
-            N.append(np.outer(na, nb).ravel())
-            w.append(W1[a] * W1[b])
-    return np.array(N), np.array(w)
+    n, _ = plate_fe.lagrange2(plate_fe.GAUSS_X)
+    return (np.einsum('ai,bj->abij', n, n).reshape(9, 9),
+            np.outer(plate_fe.GAUSS_W, plate_fe.GAUSS_W).ravel())
 
 
 class Plate:
