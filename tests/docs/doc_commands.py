@@ -21,7 +21,8 @@ Never run, in any mode (reason printed): the `./setup.sh && ` prefix of the
 README's commands is the first README command itself (done: dropped);
 configuring or building (cmake -S/-B, cmake --build: the build is the first
 README command's, and a second configure of it from the copy is refused by
-CMake); ctest (the suite itself).
+CMake); ./setup.sh --debug (the sanitizer build, which .ci/run builds with the
+same command); ctest (the suite itself).
 
 MPS_DOC_TEST_SHORT=1 (ctest sets it): the long ones are shortened by the
 table SHORT (end_time/dp overrides, or skipped with a reason). Every entry
@@ -50,6 +51,10 @@ NEVER = [
     (re.compile(r'^cmake -S .*$', re.M), 'true',
      'configures and builds build/: the first README command did'),
     (re.compile(r'^(ctest|cd build && ctest)\b.*$', re.M), 'true', 'runs the test suite itself'),
+    # 1.5 min each from scratch in the copy, and the same command as .ci/run's
+    (re.compile(r'^(MPS_WERROR=ON )?\./setup\.sh --debug$', re.M), 'true',
+     'builds the sanitizer build (build-debug/): .ci/run runs MPS_WERROR=ON ./setup.sh --debug '
+     'itself'),
 ]
 
 # (file, pattern, Python module, reason): run only where the module imports
