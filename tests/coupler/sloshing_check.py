@@ -31,6 +31,7 @@ import yaml
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
 from probes_csv import probes_table  # noqa: E402
+import sloshing_phase  # noqa: E402
 
 
 def main():
@@ -81,17 +82,13 @@ def main():
 
     t = d['time']
     n = int((t[-1] - a.t0) / T + 1e-9)
-    m = (t >= a.t0) & (t <= a.t0 + n * T)
-    w = 2 * math.pi / T
     if n < 1:
         bad.append(f'less than a period after t0 = {a.t0} s')
     else:
-        z_tip = np.trapz(d['tip_dx'][m] * np.exp(-1j * w * t[m]), t[m])
-        z_push = np.trapz(-d['tank_angle'][m] * np.exp(-1j * w * t[m]), t[m])
-        lag = math.degrees(np.angle(z_push / z_tip))
+        lag, tip, _ = sloshing_phase.lag(t, d['tip_dx'], d['tank_angle'], a.t0, n, T)
         print(f'phase: over {n} period(s) from {a.t0} s, tip_dx lags -theta by {lag:+.1f} deg '
               f'(band {a.lag_band[0]:g} to {a.lag_band[1]:g}); first-harmonic amplitude '
-              f'{2 * abs(z_tip) / (n * T) * 100:.2f} cm')
+              f'{tip * 100:.2f} cm')
         if not a.lag_band[0] <= lag <= a.lag_band[1]:
             bad.append('the plate moves in the wrong phase')
     for b in bad:
