@@ -1,0 +1,196 @@
+#!/usr/bin/python3
+"""Where the dam-break plate's force noise is (docs/pressure.md, "The 3 mm
+plate's force noise: where it is").
+
+usage: bench/plate_force_noise.py RUN [RUN ...] [--after 0.7] [--before 1.25]
+                                  [--snapshots] [--dp DP]
+
+For each RUN (a coupled run of cases/dambreak_elastic_plate):
+- the issue's measure (tests/coupler/check_plate_flicker.py): the share of
+  the 2 ms force rows within 15% of their 20 ms running mean, split into the
+  rows where that mean is at least 10% of the peak ("loaded") and the rest
+  ("quiet"), where the band is the floor's absolute 1.5% of the peak. Needs
+  probes every 2 ms (the case's output.probe_interval);
+- with probes finer than the fluid's step (output.probe_interval=2.5e-4: a
+  probe row then holds one coupling step's load), the RMS of the step loads'
+  deviation from their running mean over about 20 ms, and its lag-1
+  autocorrelation (about -0.3 for a step-to-step alternation, near 1 for a
+  smooth signal), over --after to --before s; the same for each probe
+  column whose name starts with wall_ (fluid probes of kind wall_force);
+- --snapshots (output.interval below the fluid's step, e.g. 5e-4): from the
+  solid snapshots, the step-to-step change of the x-load on each face of the
+  plate and the correlation of the two faces' changes (near -1: the
+  pressure on both faces rises and falls together, and the net force is
+  what of it does not cancel); from the fluid snapshots, the RMS step
+  change of the pressure of fluid particles within 1.6 dp of the plate and
+  of the tank's right wall, below y = 0.06 m.
+The plate's faces are the columns of the smallest and largest starting x
+(position - displacement) of the solid particles."""
+import argparse
+import glob
+import os
+import sys
+
+import h5py
+import numpy as np
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, 'tests', 'coupler'))
+from check_plate_flicker import probes_table  # noqa: E402
+
+WINDOW = 0.02  # s: the issue's running mean
+TANK_RIGHT = 0.584  # m: the case's tank width
+
+
+def split_within15(t, fx):
+    """The issue's measure split by the running mean's size: (all, loaded,
+    quiet, share of quiet rows) and the quiet rows' RMS deviation from the
+    mean (N/m), or None for probes finer than 1.5 ms."""
+    h = np.median(np.diff(t))
+    if h < 1.5e-3:
+        return None
+    w = max(1, int(round(WINDOW / h)))
+    peak = np.abs(fx).max()
+    t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
+    mean = np.convolve(fx, np.ones(w) / w, mode='same')
+    m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
+    dev = np.abs(fx - mean)
+    ok = dev <= 0.15 * np.maximum(np.abs(mean), 0.1 * peak)
+    quiet = np.abs(mean) < 0.1 * peak
+    shares = (ok[m].mean(), ok[m & ~quiet].mean(), ok[m & quiet].mean(), (m & quiet).sum() / m.sum())
+    return shares, float(np.sqrt(np.mean(dev[m & quiet] ** 2)))
+
+
+def step_noise(t, fx, probe_interval, after, before):
+    """RMS of the step loads about their ~20 ms running mean, lag-1
+    autocorrelation; None unless probes are at most 0.5 ms apart (then,
+    shorter than the fluid's step, each row holds one step's load)."""
+    if probe_interval > 5e-4:
+        return None
+    w = 2 * int(round(WINDOW / np.median(np.diff(t[(t > after) & (t < before)])) / 2)) + 1
+    dev = fx - np.convolve(fx, np.ones(w) / w, mode='same')
+    x = dev[(t > after) & (t < before)]
+    return float(x.std()), float(np.corrcoef(x[:-1], x[1:])[0, 1])
+
+
+def snapshot_series(run, kind, after, before):
+    out = []
+    for fn in sorted(glob.glob(os.path.join(run, f'{kind}_*.h5'))):
+        with h5py.File(fn, 'r') as f:
+            t = float(f.attrs['time'])
+            if after <= t <= before:
+                out.append((t, fn))
+    # a snapshot whose time repeats (two outputs inside one step) is one step
+    seen, uniq = set(), []
+    for t, fn in out:
+        if t not in seen:
+            seen.add(t)
+            uniq.append((t, fn))
+    return uniq
+
+
+def face_loads(run, after, before):
+    """Step changes of the x-load on each face (N/m): RMS left, RMS right,
+    their correlation, and the RMS step change of the net load."""
+    left, right = [], []
+    for _, fn in snapshot_series(run, 'solid', after, before):
+        with h5py.File(fn, 'r') as f:
+            x0 = f['particles/position'][:][:, 0] - f['particles/displacement'][:][:, 0]
+            ax = f['particles/load_acceleration'][:][:, 0]
+            case = yaml.safe_load(f['config'][()].decode())
+        x0 = np.round(x0, 7)
+        cols = np.unique(x0)
+        # a particle's mass per metre: the body's density times its area,
+        # the solid's spacing squared (dp / solid.refine)
+        dps = case['dp'] / case['solid'].get('refine', 1)
+        mass = case['solid']['bodies'][0]['rho'] * dps * dps
+        left.append(mass * ax[x0 == cols[0]].sum())
+        right.append(mass * ax[x0 == cols[-1]].sum())
+    if len(left) < 3:
+        return None
+    dl, dr = np.diff(left), np.diff(right)
+    return float(dl.std()), float(dr.std()), float(np.corrcoef(dl, dr)[0, 1]), \
+        float(np.diff(np.add(left, right)).std())
+
+
+def near_pressure(run, dp, after, before):
+    """RMS step change of the pressure (Pa) of the fluid particles within
+    1.6 dp of the plate and of the right wall, below y = 0.06 m, following
+    each particle by its id."""
+    from scipy.spatial import cKDTree
+    solids = dict(snapshot_series(run, 'solid', after, before))
+    prev, acc = None, {'plate': [], 'right wall': []}
+    for t, fn in snapshot_series(run, 'fluid', after, before):
+        if t not in solids:
+            continue
+        with h5py.File(fn, 'r') as f:
+            fluid = f['particles/type'][:] == 0
+            x = f['particles/position'][:][:, :2]
+            p = f['particles/pressure'][:]
+            ids = f['particles/id'][:]
+        with h5py.File(solids[t], 'r') as g:
+            xs = g['particles/position'][:][:, :2]
+        dist, _ = cKDTree(xs).query(x)
+        low = fluid & (x[:, 1] < 0.06)
+        cur = {}
+        for name, sel in (('plate', low & (dist < 1.6 * dp)),
+                          ('right wall', low & (x[:, 0] > TANK_RIGHT - 1.6 * dp))):
+            cur.update({(name, i): v for i, v in zip(ids[sel], p[sel])})
+        if prev is not None:
+            for k, v in cur.items():
+                if k in prev:
+                    acc[k[0]].append(v - prev[k])
+        prev = cur
+    return {k: float(np.sqrt(np.mean(np.square(v)))) if v else float('nan')
+            for k, v in acc.items()}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
+    ap.add_argument('runs', nargs='+')
+    ap.add_argument('--after', type=float, default=0.7)
+    ap.add_argument('--before', type=float, default=1.25)
+    ap.add_argument('--snapshots', action='store_true')
+    ap.add_argument('--dp', type=float, default=None, help='the fluid spacing (for --snapshots)')
+    a = ap.parse_args()
+    status = 0
+    for run in a.runs:
+        path = os.path.join(run, 'probes.csv')
+        if not os.path.exists(path):
+            print(f'{run}: no probes.csv', file=sys.stderr)
+            status = 1
+            continue
+        p = probes_table(path)
+        t, fx = p['time'], p['solid_fx']
+        parts = [run]
+        s = split_within15(t, fx)
+        if s:
+            parts.append('2 ms rows within 15%%: %.1f%% (loaded %.1f%%, quiet %.1f%%; quiet rows %.0f%%)'
+                         % tuple(100 * v for v in s[0]) + ', quiet rows off their mean by %.2f N/m RMS'
+                         % s[1])
+        with open(os.path.join(run, 'case_resolved.yml')) as f:
+            case = yaml.safe_load(f)
+        pi = float(case['output']['probe_interval'])
+        n = step_noise(t, fx, pi, a.after, a.before)
+        if n:
+            parts.append('step loads %.2f N/m RMS about the 20 ms mean, lag-1 %+.2f' % n)
+        for col in p.dtype.names:
+            n = step_noise(t, p[col], pi, a.after, a.before) if col.startswith('wall_') else None
+            if n:
+                parts.append('%s %.2f N/m, lag-1 %+.2f' % ((col,) + n))
+        if a.snapshots:
+            if a.dp is None:
+                ap.error('--snapshots needs --dp')
+            f = face_loads(run, a.after, a.before)
+            if f:
+                parts.append('faces step change %.1f / %.1f N/m, correlation %+.2f, net %.1f N/m' % f)
+            q = near_pressure(run, a.dp, a.after, a.before)
+            parts.append('pressure step change next to the plate %.0f Pa, the right wall %.0f Pa'
+                         % (q['plate'], q['right wall']))
+        print(' | '.join(parts))
+    return status
+
+
+if __name__ == '__main__':
+    sys.exit(main())
