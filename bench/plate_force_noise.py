@@ -21,7 +21,9 @@ For each RUN (a coupled run of cases/dambreak_elastic_plate):
   solid snapshots, the step-to-step change of the x-load on each face of the
   plate and the correlation of the two faces' changes (near -1: the
   pressure on both faces rises and falls together, and the net force is
-  what of it does not cancel); from the fluid snapshots, the RMS step
+  what of it does not cancel), the share of the faces' particles (below
+  y = 0.06 m) at exactly zero load and the fast part of their velocity;
+  from the fluid snapshots, the RMS step
   change of the pressure of fluid particles within 1.6 dp of the plate and
   of the tank's right wall, below y = 0.06 m.
 The plate's faces are the columns of the smallest and largest starting x
@@ -91,27 +93,40 @@ def snapshot_series(run, kind, after, before):
 
 
 def face_loads(run, after, before):
-    """Step changes of the x-load on each face (N/m): RMS left, RMS right,
-    their correlation, and the RMS step change of the net load."""
-    left, right = [], []
+    """Over the plate's two faces: the step changes of each face's x-load
+    (N/m; RMS left, RMS right, their correlation, the RMS step change of the
+    net load), the share of the faces' particles below y = 0.06 m whose load
+    is exactly zero, and the fast part of their x-velocity (m/s RMS, a 9-step
+    running mean removed: the solid's particle-scale motion that the fluid's
+    divergence reads)."""
+    left, right, zero, vel = [], [], [], []
     for _, fn in snapshot_series(run, 'solid', after, before):
         with h5py.File(fn, 'r') as f:
-            x0 = f['particles/position'][:][:, 0] - f['particles/displacement'][:][:, 0]
-            ax = f['particles/load_acceleration'][:][:, 0]
+            pos = f['particles/position'][:][:, :2]
+            x0 = np.round(pos - f['particles/displacement'][:][:, :2], 7)
+            ax = f['particles/load_acceleration'][:][:, :2]
+            vx = f['particles/velocity'][:][:, 0]
             case = yaml.safe_load(f['config'][()].decode())
-        x0 = np.round(x0, 7)
-        cols = np.unique(x0)
+        cols = np.unique(x0[:, 0])
         # a particle's mass per metre: the body's density times its area,
         # the solid's spacing squared (dp / solid.refine)
         dps = case['dp'] / case['solid'].get('refine', 1)
         mass = case['solid']['bodies'][0]['rho'] * dps * dps
-        left.append(mass * ax[x0 == cols[0]].sum())
-        right.append(mass * ax[x0 == cols[-1]].sum())
-    if len(left) < 3:
+        faces = (x0[:, 0] == cols[0]) | (x0[:, 0] == cols[-1])
+        low = faces & (x0[:, 1] < 0.06)
+        left.append(mass * ax[x0[:, 0] == cols[0], 0].sum())
+        right.append(mass * ax[x0[:, 0] == cols[-1], 0].sum())
+        zero.append(np.mean(np.hypot(ax[low, 0], ax[low, 1]) == 0.0))
+        vel.append(vx[low])
+    if len(left) < 20:
         return None
     dl, dr = np.diff(left), np.diff(right)
+    v = np.array(vel)
+    k = 9
+    smooth = np.apply_along_axis(lambda a: np.convolve(a, np.ones(k) / k, mode='same'), 0, v)
     return float(dl.std()), float(dr.std()), float(np.corrcoef(dl, dr)[0, 1]), \
-        float(np.diff(np.add(left, right)).std())
+        float(np.diff(np.add(left, right)).std()), float(np.mean(zero)), \
+        float((v - smooth)[k:-k].std())
 
 
 def near_pressure(run, dp, after, before):
@@ -184,7 +199,9 @@ def main():
                 ap.error('--snapshots needs --dp')
             f = face_loads(run, a.after, a.before)
             if f:
-                parts.append('faces step change %.1f / %.1f N/m, correlation %+.2f, net %.1f N/m' % f)
+                parts.append('faces step change %.1f / %.1f N/m, correlation %+.2f, net %.1f N/m; '
+                             'faces\' particles at zero load %.1f%%; their fast x-velocity %.4f m/s'
+                             % (f[:4] + (100 * f[4], f[5])))
             q = near_pressure(run, a.dp, a.after, a.before)
             parts.append('pressure step change next to the plate %.0f Pa, the right wall %.0f Pa'
                          % (q['plate'], q['right wall']))
