@@ -39,29 +39,22 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'coupler'))
-from check_plate_flicker import probes_table  # noqa: E402
+from check_plate_flicker import force_series_smoothness, probes_table  # noqa: E402
 
 WINDOW = 0.02  # s: the issue's running mean
 TANK_RIGHT = 0.584  # m: the case's tank width
 
 
 def split_within15(t, fx):
-    """The issue's measure split by the running mean's size: (all, loaded,
-    quiet, share of quiet rows) and the quiet rows' RMS deviation from the
-    mean (N/m), or None for probes finer than 1.5 ms."""
-    h = np.median(np.diff(t))
-    if h < 1.5e-3:
+    """The issue's measure (check_plate_flicker.force_series_smoothness)
+    split by the running mean's size: (all, loaded, quiet, share of quiet
+    rows) and the quiet rows' RMS deviation from the mean (N/m), or None for
+    probes finer than 1.5 ms."""
+    if np.median(np.diff(t)) < 1.5e-3:
         return None
-    w = max(1, int(round(WINDOW / h)))
-    peak = np.abs(fx).max()
-    t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
-    mean = np.convolve(fx, np.ones(w) / w, mode='same')
-    m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
-    dev = np.abs(fx - mean)
-    ok = dev <= 0.15 * np.maximum(np.abs(mean), 0.1 * peak)
-    quiet = np.abs(mean) < 0.1 * peak
-    shares = (ok[m].mean(), ok[m & ~quiet].mean(), ok[m & quiet].mean(), (m & quiet).sum() / m.sum())
-    return shares, float(np.sqrt(np.mean(dev[m & quiet] ** 2)))
+    r = force_series_smoothness(t, fx)
+    return (r['within15'], r['within15_loaded'], r['within15_quiet'], r['quiet_share']), \
+        r['quiet_rms_dev']
 
 
 def step_noise(t, fx, probe_interval, after, before):
@@ -97,8 +90,7 @@ def face_loads(run, after, before):
     (N/m; RMS left, RMS right, their correlation, the RMS step change of the
     net load), the share of the faces' particles below y = 0.06 m whose load
     is exactly zero, and the fast part of their x-velocity (m/s RMS, a 9-step
-    running mean removed: the solid's particle-scale motion that the fluid's
-    divergence reads)."""
+    running mean removed: the solid's particle-scale motion)."""
     left, right, zero, vel = [], [], [], []
     for _, fn in snapshot_series(run, 'solid', after, before):
         with h5py.File(fn, 'r') as f:

@@ -80,10 +80,18 @@ def force_series_smoothness(t, fx):
     m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
     dev = np.abs(fx - mean)[m]
     ref = np.maximum(np.abs(mean[m]), 0.1 * peak)
+    ok = dev <= 0.15 * ref
+    # "quiet": rows whose mean is under the floor, where the band is an
+    # absolute 1.5% of the peak (bench/plate_force_noise.py splits by it)
+    quiet = np.abs(mean[m]) < 0.1 * peak
     return {'first_impact_s': float(t0), 'peak': float(peak),
-            'within15': float(np.mean(dev <= 0.15 * ref)),
+            'within15': float(np.mean(ok)),
             'rms_dev': float(np.sqrt(np.mean(dev ** 2))),
-            'step_change': float(np.mean(np.abs(np.diff(fx[m]))))}
+            'step_change': float(np.mean(np.abs(np.diff(fx[m])))),
+            'within15_loaded': float(np.mean(ok[~quiet])) if (~quiet).any() else float('nan'),
+            'within15_quiet': float(np.mean(ok[quiet])) if quiet.any() else float('nan'),
+            'quiet_share': float(np.mean(quiet)),
+            'quiet_rms_dev': float(np.sqrt(np.mean(dev[quiet] ** 2))) if quiet.any() else float('nan')}
 
 
 def main():
