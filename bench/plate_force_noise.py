@@ -24,7 +24,7 @@ For each RUN (a coupled run of cases/dambreak_elastic_plate):
   what of it does not cancel), the share of the faces' particles (below
   y = 0.06 m) at exactly zero load and the fast part of their velocity;
   from the fluid snapshots, the RMS step
-  change of the pressure of fluid particles within 1.6 dp of the plate and
+  change of the pressure and of the x-velocity of fluid particles within 1.6 dp of the plate and
   of the tank's right wall, below y = 0.06 m.
 The plate's faces are the columns of the smallest and largest starting x
 (position - displacement) of the solid particles."""
@@ -122,9 +122,9 @@ def face_loads(run, after, before):
 
 
 def near_pressure(run, dp, after, before):
-    """RMS step change of the pressure (Pa) of the fluid particles within
-    1.6 dp of the plate and of the right wall, below y = 0.06 m, following
-    each particle by its id."""
+    """RMS step change of the pressure (Pa) and of the x-velocity (m/s) of
+    the fluid particles within 1.6 dp of the plate and of the right wall,
+    below y = 0.06 m, following each particle by its id: {region: (Pa, m/s)}."""
     from scipy.spatial import cKDTree
     solids = dict(snapshot_series(run, 'solid', after, before))
     prev, acc = None, {'plate': [], 'right wall': []}
@@ -135,6 +135,7 @@ def near_pressure(run, dp, after, before):
             fluid = f['particles/type'][:] == 0
             x = f['particles/position'][:][:, :2]
             p = f['particles/pressure'][:]
+            vx = f['particles/velocity'][:][:, 0]
             ids = f['particles/id'][:]
         with h5py.File(solids[t], 'r') as g:
             xs = g['particles/position'][:][:, :2]
@@ -143,13 +144,13 @@ def near_pressure(run, dp, after, before):
         cur = {}
         for name, sel in (('plate', low & (dist < 1.6 * dp)),
                           ('right wall', low & (x[:, 0] > TANK_RIGHT - 1.6 * dp))):
-            cur.update({(name, i): v for i, v in zip(ids[sel], p[sel])})
+            cur.update({(name, i): (a, b) for i, a, b in zip(ids[sel], p[sel], vx[sel])})
         if prev is not None:
             for k, v in cur.items():
                 if k in prev:
-                    acc[k[0]].append(v - prev[k])
+                    acc[k[0]].append((v[0] - prev[k][0], v[1] - prev[k][1]))
         prev = cur
-    return {k: float(np.sqrt(np.mean(np.square(v)))) if v else float('nan')
+    return {k: tuple(np.sqrt(np.mean(np.square(v), axis=0))) if v else (float('nan'),) * 2
             for k, v in acc.items()}
 
 
@@ -195,8 +196,8 @@ def main():
                              'faces\' particles at zero load %.1f%%; their fast x-velocity %.4f m/s'
                              % (f[:4] + (100 * f[4], f[5])))
             q = near_pressure(run, a.dp, a.after, a.before)
-            parts.append('pressure step change next to the plate %.0f Pa, the right wall %.0f Pa'
-                         % (q['plate'], q['right wall']))
+            parts.append('step change next to the plate %.0f Pa and %.4f m/s, the right wall '
+                         '%.0f Pa and %.4f m/s' % (q['plate'] + q['right wall']))
         print(' | '.join(parts))
     return status
 
