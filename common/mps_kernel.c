@@ -37,6 +37,33 @@ struct mps_lattice_consts mps_lattice_consts(double l0, double re)
     return c;
 }
 
+/* sum_j -w'(r) e_ij over the lattice, the middle particle moved by dx along x */
+static double lattice_gradient_x(double l0, double re, int smooth, double dx)
+{
+    int k = (int)ceil(re / l0) + 1;
+    double g = 0.0;
+#if MPS_DIM == 2
+    for (int a = -k; a <= k; a++)
+        for (int b = -k; b <= k; b++) {
+            double x = l0 * a - dx, y = l0 * b, r = sqrt(x * x + y * y);
+            if ((a == 0 && b == 0) || r >= re)
+                continue;
+            double dw = smooth ? 2.0 * (1.0 - r / re) / re : re / (r * r);
+            g += dw * x / r;
+        }
+#else
+#error "lattice_gradient_x: only MPS_DIM == 2 is implemented"
+#endif
+    return g;
+}
+
+double mps_lattice_gradient_response(double l0, double re, int smooth)
+{
+    const double h = 1e-6 * l0;
+    return fabs(lattice_gradient_x(l0, re, smooth, h) - lattice_gradient_x(l0, re, smooth, -h)) /
+           (2.0 * h);
+}
+
 void mps_weights_r2_sse2(double *restrict w, size_t n, double re, double scale)
 {
     size_t k = 0;

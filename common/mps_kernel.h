@@ -72,4 +72,9 @@ struct mps_lattice_consts {
  * effective radius re (both in m). */
 struct mps_lattice_consts mps_lattice_consts(double l0, double re);
 
+/* How fast sum_j -w'(r_ij) e_ij (the particle shifting's gradient) grows as
+ * the middle particle of a full square lattice moves off its site, per metre
+ * of its displacement: w = mps_weight, or mps_weight_quadratic if smooth. */
+double mps_lattice_gradient_response(double l0, double re, int smooth);
+
 #endif

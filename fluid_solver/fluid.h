@@ -91,6 +91,8 @@ struct fluid {
     /* lattice constants */
     double n0, n0_lap, lambda_lap;
     double nq0;            /* mps_lattice_consts' nq0 at re_n (fluid.density_weight) */
+    double shift_gain;     /* fluid.shifting_weight smooth: the MPS weight's lattice
+                            * response over the smooth one's (about 5 at re = 2.1 dp) */
     double load_scale;     /* Eq. 50 normalisation, see fluid_coupling.c */
     int solid_placed;      /* walls under the solid removed */
     int count0;

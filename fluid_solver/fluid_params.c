@@ -138,6 +138,9 @@ const struct mps_key_spec fluid_case_keys[] = {
      "particle shifting coefficient A of dr = -A dp |v| dt grad n / n0 (0: off)"},
     {"fluid.shifting_max", MPS_KEY_DOUBLE, "0.1", 0, 1, MPS_KEY_LO_OPEN, NULL, "dp",
      "largest shift per step"},
+    {"fluid.shifting_weight", MPS_KEY_ENUM, "mps", 0, 0, 0, "mps|smooth", "",
+     "the weight whose gradient the shifting follows: Eq. 3's (mps), singular at r = 0, or "
+     "(1 - r/re)^2 (smooth), scaled to the same response on the lattice; see docs/pressure.md"},
     {"fluid.ppe_solver", MPS_KEY_ENUM, "auto", 0, 0, 0,
      "auto|pcg_jacobi|pcg_ic0|pcg_sic0|pcg_defl|cholmod|cholmod_reuse", "",
      "linear solver for the PPE"},
@@ -366,6 +369,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
                              "viscous");
     p->shift_coef = mps_case_double(c, "fluid.shifting");
     p->shift_max = mps_case_double(c, "fluid.shifting_max");
+    p->shift_smooth = strcmp(mps_case_string(c, "fluid.shifting_weight"), "smooth") == 0;
     p->jitter = mps_case_double(c, "fluid.jitter.amplitude");
     p->jitter_seed = (unsigned long)mps_case_int(c, "fluid.jitter.seed");
     p->ppe_solver = mps_case_string(c, "fluid.ppe_solver");

@@ -88,6 +88,7 @@ struct fluid_params {
     double side_wall_period;      /* s: their boundary layers' period; 0 = the motion's */
     int side_wall_inertia;        /* the layers' reactive half too (an inertia), not the drag only */
     double shift_coef, shift_max; /* particle shifting: A (0 = off), cap in dp */
+    int shift_smooth;             /* shifting along the smooth weight's gradient */
     double jitter;                /* dp: largest start displacement per axis; 0 = lattice */
     unsigned long jitter_seed;    /* which realisation of the jitter */
     const char *ppe_solver;

@@ -520,6 +520,34 @@ static void test_no_r2(void)
  * AVX-512 path with the portable one, and reports SKIPPED (77) where there is
  * no AVX-512 path (the CPU lacks it, or MPS_SIMD=sse2): without it those
  * parts test the portable path only, which the plain run covers. */
+/* The shifting's lattice response (fluid.shifting_weight): d/d eps of
+ * sum_j g(r) x_j, g = -w'(r) / r, summed here from the derivative
+ * g(r) + g'(r) x^2 / r of each term, against the solver's difference. */
+static void test_gradient_response(void)
+{
+    const double l0 = 0.003, re = 2.1 * l0;
+    double mps = 0.0, smooth = 0.0;
+    for (int a = -3; a <= 3; a++)
+        for (int b = -3; b <= 3; b++) {
+            double x = l0 * a, r = l0 * hypot(a, b);
+            if (!(a || b) || r >= re)
+                continue;
+            /* w = re/r - 1: g = re/r^3, g' = -3 re/r^4 */
+            mps += re / (r * r * r) - 3.0 * re * x * x / pow(r, 5);
+            /* w = (1 - r/re)^2: g = 2/(re r) - 2/re^2, g' = -2/(re r^2) */
+            smooth += 2.0 / (re * r) - 2.0 / (re * re) - 2.0 * x * x / (re * r * r * r);
+        }
+    double rm = mps_lattice_gradient_response(l0, re, 0);
+    double rs = mps_lattice_gradient_response(l0, re, 1);
+    CHECK_NEAR(rm, fabs(mps), 1e-6 * fabs(mps));
+    CHECK_NEAR(rs, fabs(smooth), 1e-6 * fabs(smooth));
+    /* per unit of l0^-2 they do not depend on the spacing; the ratio the
+     * shifting scales the smooth weight by is about 5 at re = 2.1 l0 */
+    CHECK_NEAR(rm / rs, mps_lattice_gradient_response(1.0, 2.1, 0) /
+                            mps_lattice_gradient_response(1.0, 2.1, 1), 1e-6);
+    CHECK(rm / rs > 4.9 && rm / rs < 5.1);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -541,5 +569,6 @@ int main(int argc, char **argv)
     test_lattice(0.01, -0.35);
     test_errors();
     test_kernel();
+    test_gradient_response();
     return test_summary("test_nbr");
 }
