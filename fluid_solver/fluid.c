@@ -423,7 +423,7 @@ static long collide(struct fluid *f, double dt)
  * by shift_gain, a particle off its lattice site is shifted as much as with
  * Eq. 3's weight. At 3 mm the plate's step-to-step load noise fell from 14.1
  * to 8.4 N/m with it (docs/pressure.md, "The particle shifting's weight"). */
-static void shift(struct fluid *f, double dt)
+void fluid_shift(struct fluid *f, double dt)
 {
     const struct fluid_params *p = &f->prm;
     const double A = p->shift_coef, re = p->re_n * p->dp, re2 = re * re;
@@ -864,7 +864,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
             f->x[i][d] += dt * dv;
         }
 
-    shift(f, dt);
+    fluid_shift(f, dt);
     if (ghosts)
         fluid_ppe_boundary_clamp(f);
     mps_timer_switch(&f->timer, PH_OTHER);

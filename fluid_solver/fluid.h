@@ -179,6 +179,11 @@ void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows);
 /* Recomputes the type masks (has_p, is_fluid) after particle types change. */
 void fluid_update_masks(struct fluid *f);
 
+/* The particle shifting at the end of a step (fluid.shifting, its weight
+ * fluid.shifting_weight), over the neighbour list of the step; public for
+ * the known-answer test. */
+void fluid_shift(struct fluid *f, double dt);
+
 /* Fills f->acc for every particle at time t (fluid_body.c): prm.g in a fixed
  * tank, else the moving frame's body acceleration at each particle's x, v. */
 void fluid_body_accel(struct fluid *f, double t);

@@ -1158,6 +1158,94 @@ static void test_divergence_slip(void)
     fluid_destroy(&f);
 }
 
+/* The shifting's displacement against its formula, summed here over the
+ * step's neighbour list, for each weight: dr = -A dp |v| dt s g / n0 with
+ * g = sum_j -w'(r) e_ij, s = 1 for Eq. 3's weight and, for (1 - r/re)^2,
+ * the ratio of the two lattice responses from their derivatives summed
+ * over the lattice (test_nbr checks mps_lattice_gradient_response the same
+ * way). Particles on or next to the free surface (tangential part only) and
+ * those at the cap are left out. */
+static void test_shifting(void)
+{
+    for (int smooth = 0; smooth <= 1; smooth++) {
+        const char *sets[] = {"dp=0.02", smooth ? "fluid.shifting_weight=smooth"
+                                                : "fluid.shifting_weight=mps"};
+        struct fluid *f = make_stepped("cases/dambreak/case.yml", sets, 2, 5);
+        if (!f)
+            return;
+        const struct fluid_params *p = &f->prm;
+        const double dt = 1e-3, re = p->re_n * p->dp;
+        double ratio = 1.0;
+        if (smooth) {
+            double rm = 0.0, rs = 0.0;
+            for (int a = -3; a <= 3; a++)
+                for (int b = -3; b <= 3; b++) {
+                    double x = a, r = hypot(a, b), q = p->re_n;
+                    if (!(a || b) || r >= q)
+                        continue;
+                    rm += q / (r * r * r) - 3.0 * q * x * x / pow(r, 5);
+                    rs += 2.0 / (q * r) - 2.0 / (q * q) - 2.0 * x * x / (q * r * r * r);
+                }
+            ratio = fabs(rm / rs);
+        }
+        const size_t nf = f->nfluid;
+        double(*want)[MPS_DIM] = calloc(nf, sizeof *want);
+        double(*x0)[MPS_DIM] = calloc(nf, sizeof *x0);
+        unsigned char *use = calloc(nf, 1);
+        CHECK(want && x0 && use);
+        if (!want || !x0 || !use) {
+            free(want), free(x0), free(use);
+            fluid_destroy(&f);
+            return;
+        }
+        int compared = 0;
+        for (size_t i = 0; i < nf; i++) {
+            double g[MPS_DIM] = {0}, v2 = 0.0;
+            int near_surf = f->surface[i];
+            for (size_t k = f->nl_n.start[i]; k < f->nl_n.start[i + 1]; k++) {
+                int j = f->nl_n.j[k];
+                double dx[MPS_DIM], r2 = 0.0;
+                for (int d = 0; d < MPS_DIM; d++) {
+                    dx[d] = f->x[j][d] - f->x[i][d];
+                    r2 += dx[d] * dx[d];
+                }
+                double r = sqrt(r2);
+                if (r >= re || r <= 0.0)
+                    continue;
+                double dw = smooth ? 2.0 * (1.0 - r / re) / re : re / (r * r);
+                for (int d = 0; d < MPS_DIM; d++)
+                    g[d] += dw * dx[d] / r;
+                near_surf |= f->is_fluid[j] && f->surface[j];
+            }
+            for (int d = 0; d < MPS_DIM; d++)
+                v2 += f->v[i][d] * f->v[i][d];
+            double len2 = 0.0;
+            for (int d = 0; d < MPS_DIM; d++) {
+                want[i][d] = -p->shift_coef * p->dp * sqrt(v2) * dt * ratio / f->n0 * g[d];
+                len2 += want[i][d] * want[i][d];
+                x0[i][d] = f->x[i][d];
+            }
+            use[i] = !near_surf && len2 > 0.0 && sqrt(len2) < 0.999 * p->shift_max * p->dp;
+        }
+        fluid_shift(f, dt);
+        double worst = 0.0, big = 0.0;
+        for (size_t i = 0; i < nf; i++) {
+            if (!use[i])
+                continue;
+            compared++;
+            for (int d = 0; d < MPS_DIM; d++) {
+                worst = fmax(worst, fabs(f->x[i][d] - x0[i][d] - want[i][d]));
+                big = fmax(big, fabs(want[i][d]));
+            }
+        }
+        printf("shifting (%s weight): %d interior particles, |dr - formula| <= %.3g of %.3g m\n",
+               smooth ? "smooth" : "Eq. 3's", compared, worst, big);
+        CHECK(compared > 20 && big > 0.0 && worst <= 1e-9 * big);
+        free(want), free(x0), free(use);
+        fluid_destroy(&f);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -1184,5 +1272,6 @@ int main(int argc, char **argv)
     test_guard_log();
     test_side_walls();
     test_jitter();
+    test_shifting();
     return test_summary("test_fluid_step");
 }
