@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/prctl.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
@@ -72,6 +73,27 @@ static struct {
     char places[8192];
 } shared;
 
+/* Claims CPU `cpu` for this coupler's life: an exclusive flock on a file
+ * named after it, which the kernel drops when the coupler exits however it
+ * ends. Every coupler on the machine uses the same names, whoever runs it
+ * (the file is made readable by all; a lock needs only a read descriptor).
+ * Returns 1 if claimed. The descriptor is kept open on purpose. */
+static int claim_cpu(int cpu)
+{
+    char path[64];
+    snprintf(path, sizeof path, "/tmp/mpsfsi-cpu%d.lock", cpu);
+    /* O_NOFOLLOW: a symlink planted in /tmp under this name is refused,
+     * not followed to another file */
+    int fd = open(path, O_RDONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
+    if (fd < 0)
+        return 0;
+    if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+        close(fd);
+        return 0;
+    }
+    return 1;
+}
+
 int launch_share_cpu(int want, char *note, size_t len)
 {
     if (!want) {
@@ -92,15 +114,25 @@ int launch_share_cpu(int want, char *note, size_t len)
         snprintf(note, len, "off: one CPU");
         return 0;
     }
-    int first = -1;
-    size_t used = 0;
+    /* Two couplers that both took their first allowed CPU would stack
+     * their main threads on it, each at half speed, with the other CPUs
+     * idle: measured, two 1-thread sloshing runs started together shared
+     * CPU 0 at 44% each. So each takes the first CPU no other coupler has
+     * claimed, and with none left is placed by the OS. */
+    int mine = -1;
+    for (int cpu = 0; cpu < CPU_SETSIZE && mine < 0; cpu++)
+        if (CPU_ISSET(cpu, &a) && claim_cpu(cpu))
+            mine = cpu;
+    if (mine < 0) {
+        snprintf(note, len, "off: every allowed CPU is claimed by other couplers");
+        return 0;
+    }
+    int w = snprintf(shared.places, sizeof shared.places, "{%d}", mine);
+    size_t used = (size_t)w;
     for (int cpu = 0; cpu < CPU_SETSIZE; cpu++) {
-        if (!CPU_ISSET(cpu, &a))
+        if (!CPU_ISSET(cpu, &a) || cpu == mine)
             continue;
-        if (first < 0)
-            first = cpu;
-        int w = snprintf(shared.places + used, sizeof shared.places - used, "%s{%d}",
-                         used ? "," : "", cpu);
+        w = snprintf(shared.places + used, sizeof shared.places - used, ",{%d}", cpu);
         if (w < 0 || (size_t)w >= sizeof shared.places - used) {
             snprintf(note, len, "off: too many CPUs to list in OMP_PLACES");
             return 0;
@@ -109,14 +141,14 @@ int launch_share_cpu(int want, char *note, size_t len)
     }
     cpu_set_t one;
     CPU_ZERO(&one);
-    CPU_SET(first, &one);
+    CPU_SET(mine, &one);
     if (sched_setaffinity(0, sizeof one, &one) != 0) {
         snprintf(note, len, "off: sched_setaffinity: %s", strerror(errno));
         return 0;
     }
     shared.on = 1;
     shared.allowed = a;
-    snprintf(note, len, "CPU %d shared by the coupler and the solvers' main threads", first);
+    snprintf(note, len, "CPU %d shared by the coupler and the solvers' main threads", mine);
     return 1;
 }
 

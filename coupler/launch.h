@@ -22,7 +22,9 @@ struct child {
  * takes 94 us (each hop wakes a thread on the other CPU), on one CPU 17 us
  * (bench/zmq_roundtrip.c). The processes take turns, so they can share one:
  * with want set, this pins the calling process (the coupler, before it opens
- * any socket) to its first allowed CPU, and solvers launched afterwards get
+ * any socket) to the first allowed CPU no other coupler on the machine has
+ * claimed (a lock file per CPU in /tmp, held for the coupler's life; none
+ * left: not pinned), and solvers launched afterwards get
  * every allowed CPU back with OMP_PLACES listing that CPU first and
  * OMP_PROC_BIND=close, so OpenMP binds their main thread to it and their
  * workers to the others. Does nothing with one CPU, or if the user set

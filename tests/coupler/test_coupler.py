@@ -461,9 +461,8 @@ def cpus_allowed(pid, tid=None):
     return cpus
 
 
-def placement_while_running(extra):
-    """Starts a long coupled run, and once it steps reads where the coupler
-    and the fluid's threads may run; then stops it with SIGTERM."""
+def start_long_run(extra):
+    """A long coupled run (fake solid), started and stepping: (process, out)."""
     out = tempfile.mkdtemp(prefix='cpl_cpu_')
     env = {k: v for k, v in os.environ.items() if k not in ('OMP_PLACES', 'OMP_PROC_BIND')}
     env['OMP_NUM_THREADS'] = '2'
@@ -474,6 +473,11 @@ def placement_while_running(extra):
         time.sleep(0.1)
         if os.path.exists(os.path.join(out, 'probes.csv')) and len(probes(out)) > 3:
             break
+    return p, out
+
+
+def placement_of(p):
+    """Where the coupler and its fluid's threads may run, from /proc."""
     fluid = None
     for k in subprocess.run(['pgrep', '-P', str(p.pid)], capture_output=True,
                             text=True).stdout.split():
@@ -485,10 +489,23 @@ def placement_while_running(extra):
         seen['fluid_main'] = cpus_allowed(fluid)
         seen['fluid_others'] = [cpus_allowed(fluid, int(t)) for t in os.listdir(f'/proc/{fluid}/task')
                                 if int(t) != fluid]
+    return seen
+
+
+def stop_long_run(p, out):
+    """SIGTERM, then the summary's cpu_placement."""
     p.send_signal(signal.SIGTERM)
     p.communicate(timeout=60)
     s = json.load(open(os.path.join(out, 'summary.json')))
-    return seen, s.get('cpu_placement', '')
+    return s.get('cpu_placement', '')
+
+
+def placement_while_running(extra):
+    """Starts a long coupled run, and once it steps reads where the coupler
+    and the fluid's threads may run; then stops it with SIGTERM."""
+    p, out = start_long_run(extra)
+    seen = placement_of(p)
+    return seen, stop_long_run(p, out)
 
 
 def t_cpu_placement():
@@ -513,6 +530,41 @@ def t_cpu_placement():
     check(seen['coupler'] == allowed and seen.get('fluid_main') == allowed,
           f'off: coupler and fluid on every CPU ({sorted(seen["coupler"])}, {sorted(seen.get("fluid_main", []))})')
     check(note.startswith('off'), f'summary says off: {note!r}')
+    # Two runs at once must not stack their main threads on one CPU (before
+    # the lock files both took the first allowed CPU). Another test's coupler
+    # may hold a CPU meanwhile (ctest -j2), so the second run may find every
+    # CPU claimed: it is then left to the OS and must say so.
+    runs = [start_long_run([]), start_long_run([])]
+    seen = [placement_of(p) for p, _ in runs]
+    notes = [stop_long_run(p, out) for p, out in runs]
+    pinned = [sorted(s['coupler']) for s, n in zip(seen, notes) if 'shared' in n]
+    check(len(pinned) >= 1 and all(len(c) == 1 for c in pinned),
+          f'two runs: at least one pinned to one CPU ({notes}, {[sorted(s["coupler"]) for s in seen]})')
+    check(len(pinned) < 2 or pinned[0] != pinned[1],
+          f'two runs: not pinned to the same CPU ({pinned})')
+    for s, n in zip(seen, notes):
+        if 'shared' not in n:
+            check(n.startswith('off: every allowed CPU is claimed') and s['coupler'] == allowed,
+                  f'two runs: the unpinned one says why and runs anywhere ({n!r}, {sorted(s["coupler"])})')
+    # Every CPU claimed (its lock file held here): the run is not pinned.
+    import fcntl
+    held, mine = [], set()
+    for cpu in sorted(allowed):
+        fd = os.open(f'/tmp/mpsfsi-cpu{cpu}.lock', os.O_RDONLY | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            mine.add(cpu)
+        except OSError:
+            pass  # another test's coupler holds it
+        held.append(fd)
+    seen, note = placement_while_running([])
+    for fd in held:
+        os.close(fd)
+    if 'shared' in note:  # a CPU another coupler held was freed meanwhile
+        check(not (seen['coupler'] & mine), f'all claimed: pinned only to a freed CPU ({note!r})')
+    else:
+        check(note.startswith('off: every allowed CPU is claimed') and seen['coupler'] == allowed,
+              f'all claimed: not pinned, and says why ({note!r}, {sorted(seen["coupler"])})')
 
 
 def free_port_pair():
