@@ -324,6 +324,7 @@ static enum mps_status build_neighbours(struct fluid *f, struct mps_err *err)
     if (st || (st = reorder_fluid(f, err)))
         return st;
     f->nbr_rebuilds++;
+    f->nl_gen = ++f->nl_gen_next;
     f->last.neighbour_build = 1;
     memcpy(f->xref, f->x, f->ps.n * sizeof *f->x);
     st = mps_nbr_list_build_masked(&f->nl, &f->grid, (const double(*)[MPS_DIM])f->x, f->ps.n,

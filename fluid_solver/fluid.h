@@ -132,6 +132,12 @@ struct fluid {
     double dt_kappa;           /* the last step's dt_kappa (fluid.kappa_step_decay) */
     long ppe_iterations;
     long nbr_rebuilds;
+    /* Which build the lists nl and nl_tank hold: a fresh value at every
+     * build, and a rollback that restores older lists restores their value
+     * too, so fluid_ckpt_save/restore copy the lists only when they differ
+     * from the saved ones (fluid_checkpoint.c). Never reused: from
+     * nl_gen_next, which no rollback touches. */
+    unsigned long nl_gen, nl_gen_next;
     long lost;             /* fluid particles that splashed out of an open tank */
     long wall_guard;       /* times a particle was put back inside the tank */
     long wall_guard_face[4];   /* of them through the floor, left, right wall, lid */

@@ -16,7 +16,22 @@ struct fluid_guard_log {
     double first[3];
 };
 
-enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+/* The state without the lists, then the lists: fluid_state_put writes
+ * them in the file's order (particles, lists, the rest), the rollback as two
+ * images. */
+static enum mps_status put_particles(const struct fluid *f, struct mps_ckpt *c,
+                                     struct mps_err *err)
+{
+    return mps_particles_put(&f->ps, c, err);
+}
+
+static enum mps_status put_lists(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    enum mps_status st = mps_nbr_list_put(&f->nl, "nl", c, err);
+    return st ? st : mps_nbr_list_put(&f->nl_tank, "nl_tank", c, err);
+}
+
+static enum mps_status put_rest(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     struct fluid_scalars sc = {f->nfluid, f->nfixed_end, f->time, f->dt_last, f->dt_kappa,
                                f->load_scale,
@@ -30,23 +45,25 @@ enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struc
     memset(&m, 0, sizeof m); /* padding: the image's bytes depend only on the state */
     fluid_sensors_keep(f, &m);
     enum mps_status st;
-    if ((st = mps_particles_put(&f->ps, c, err)) || (st = mps_nbr_list_put(&f->nl, "nl", c, err)) ||
-        (st = mps_nbr_list_put(&f->nl_tank, "nl_tank", c, err)) ||
-        (st = mps_ckpt_put(c, "fluid", &sc, sizeof sc, err)) ||
+    if ((st = mps_ckpt_put(c, "fluid", &sc, sizeof sc, err)) ||
         (st = mps_ckpt_put(c, "guard", &g, sizeof g, err)))
         return st;
     return mps_ckpt_put(c, "sensors", &m, sizeof m, err);
 }
 
-enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+static enum mps_status get_lists(struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    enum mps_status st = mps_nbr_list_get(&f->nl, "nl", c, err);
+    return st ? st : mps_nbr_list_get(&f->nl_tank, "nl_tank", c, err);
+}
+
+static enum mps_status get_rest(struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     struct fluid_scalars sc;
     struct fluid_guard_log g;
     struct fluid_sensors_mark m;
     enum mps_status st;
-    if ((st = mps_particles_get(&f->ps, c, err)) || (st = mps_nbr_list_get(&f->nl, "nl", c, err)) ||
-        (st = mps_nbr_list_get(&f->nl_tank, "nl_tank", c, err)) ||
-        (st = mps_ckpt_get(c, "fluid", &sc, sizeof sc, err)) ||
+    if ((st = mps_ckpt_get(c, "fluid", &sc, sizeof sc, err)) ||
         (st = mps_ckpt_get(c, "guard", &g, sizeof g, err)) ||
         (st = mps_ckpt_get(c, "sensors", &m, sizeof m, err)))
         return st;
@@ -68,6 +85,23 @@ enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_
     return MPS_OK;
 }
 
+enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    enum mps_status st;
+    if ((st = put_particles(f, c, err)) || (st = put_lists(f, c, err)))
+        return st;
+    return put_rest(f, c, err);
+}
+
+enum mps_status fluid_state_get(struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
+{
+    enum mps_status st;
+    if ((st = mps_particles_get(&f->ps, c, err)) || (st = get_lists(f, c, err)))
+        return st;
+    f->nl_gen = ++f->nl_gen_next; /* lists from a file: like no other */
+    return get_rest(f, c, err);
+}
+
 enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, struct mps_err *err)
 {
     if (strcmp(fluid_linsolve_method(f->ls), "cholmod_reuse") == 0)
@@ -75,8 +109,19 @@ enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, str
                            "fluid.ppe_solver = cholmod_reuse keeps the ordering of earlier "
                            "solves, so a repeated step would not repeat bit for bit: use "
                            "another solver with coupling.scheme: implicit");
+    c->valid = 0;
     mps_ckpt_clear(&c->img);
-    enum mps_status st = fluid_state_put(f, &c->img, err);
+    enum mps_status st = put_particles(f, &c->img, err);
+    if (!st)
+        st = put_rest(f, &c->img, err);
+    if (!st && (!c->lists_valid || c->lists_gen != f->nl_gen)) {
+        c->lists_valid = 0;
+        mps_ckpt_clear(&c->lists);
+        if (!(st = put_lists(f, &c->lists, err))) {
+            c->lists_valid = 1;
+            c->lists_gen = f->nl_gen;
+        }
+    }
     c->valid = st == MPS_OK;
     return st;
 }
@@ -86,11 +131,21 @@ enum mps_status fluid_ckpt_restore(struct fluid *f, struct fluid_ckpt *c, struct
     if (!c->valid)
         return mps_err_set(err, MPS_EINPUT, "fluid: restore without a save");
     mps_ckpt_rewind(&c->img);
-    return fluid_state_get(f, &c->img, err);
+    enum mps_status st = mps_particles_get(&f->ps, &c->img, err);
+    if (!st)
+        st = get_rest(f, &c->img, err);
+    if (!st && f->nl_gen != c->lists_gen) {
+        mps_ckpt_rewind(&c->lists);
+        if (!(st = get_lists(f, &c->lists, err)))
+            f->nl_gen = c->lists_gen;
+    }
+    return st;
 }
 
 void fluid_ckpt_free(struct fluid_ckpt *c)
 {
     mps_ckpt_free(&c->img);
+    mps_ckpt_free(&c->lists);
     c->valid = 0;
+    c->lists_valid = 0;
 }
