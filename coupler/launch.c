@@ -87,6 +87,11 @@ static int claim_cpu(int cpu)
     int fd = open(path, O_RDONLY | O_CREAT | O_NOFOLLOW | O_CLOEXEC, 0644);
     if (fd < 0)
         return 0;
+    /* a umask of 077 would leave the file unreadable to other users, whose
+     * couplers would then take the CPU as held for as long as it exists */
+    struct stat st;
+    if (fstat(fd, &st) == 0 && st.st_uid == geteuid() && (st.st_mode & 0444) != 0444)
+        (void)fchmod(fd, 0644);
     if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
         close(fd);
         return 0;
