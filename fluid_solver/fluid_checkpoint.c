@@ -16,15 +16,9 @@ struct fluid_guard_log {
     double first[3];
 };
 
-/* The state without the lists, then the lists: fluid_state_put writes
- * them in the file's order (particles, lists, the rest), the rollback as two
+/* The lists, and the state past the particles without them: fluid_state_put
+ * writes the file's order (particles, lists, the rest), the rollback two
  * images. */
-static enum mps_status put_particles(const struct fluid *f, struct mps_ckpt *c,
-                                     struct mps_err *err)
-{
-    return mps_particles_put(&f->ps, c, err);
-}
-
 static enum mps_status put_lists(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     enum mps_status st = mps_nbr_list_put(&f->nl, "nl", c, err);
@@ -88,7 +82,7 @@ static enum mps_status get_rest(struct fluid *f, struct mps_ckpt *c, struct mps_
 enum mps_status fluid_state_put(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     enum mps_status st;
-    if ((st = put_particles(f, c, err)) || (st = put_lists(f, c, err)))
+    if ((st = mps_particles_put(&f->ps, c, err)) || (st = put_lists(f, c, err)))
         return st;
     return put_rest(f, c, err);
 }
@@ -111,7 +105,7 @@ enum mps_status fluid_ckpt_save(const struct fluid *f, struct fluid_ckpt *c, str
                            "another solver with coupling.scheme: implicit");
     c->valid = 0;
     mps_ckpt_clear(&c->img);
-    enum mps_status st = put_particles(f, &c->img, err);
+    enum mps_status st = mps_particles_put(&f->ps, &c->img, err);
     if (!st)
         st = put_rest(f, &c->img, err);
     if (!st && (!c->lists_valid || c->lists_gen != f->nl_gen)) {
