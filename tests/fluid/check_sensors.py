@@ -46,6 +46,14 @@ def hydrostatic(a):
     # hydrostatic carry from the first row of fluid to the floor is worth
     # (dp/2 of h', 1.7%): a reading without the carry fails on the floor.
     tol = 0.005
+    # On the floor the carry itself is checked: the fluid's first row sits
+    # dp/2 above it, so rho g dp/2 (1.7% of the reading) is added to each
+    # particle's pressure on its way to the face. The floor readings are
+    # hydrostatic to 0.05% over this run (0.06% over 2 s); a band of 0.15%,
+    # a tenth of the carry, sees the carry 10% wrong (-0.22% measured).
+    # The side walls' normals are horizontal: no carry to check there.
+    tol_carry = 0.0015
+    carried = {'p_floor', 'force_floor'}
     expect = {
         'p_left_low': RHO * G * (hp - 0.05),       # left wall, centre 50 mm up
         'p_floor': RHO * G * hp,                   # floor, mid-width
@@ -58,10 +66,11 @@ def hydrostatic(a):
         vals = [r[name] for r in rows]
         worst = max(vals, key=lambda v: abs(v - ref))
         mean = sum(vals) / len(vals)
-        check(abs(worst - ref) <= tol * abs(ref) and abs(mean - ref) <= tol * abs(ref),
+        band = tol_carry if name in carried else tol
+        check(abs(worst - ref) <= band * abs(ref) and abs(mean - ref) <= band * abs(ref),
               f'{name}: time mean {mean:.2f}, worst interval {worst:.2f} vs {ref:.2f} '
               f'({100 * (mean / ref - 1):+.3f}%, worst {100 * (worst / ref - 1):+.3f}%; band '
-              f'{100 * tol:.1f}%)')
+              f'{100 * band:.2f}%)')
     lid = max(abs(r['force_lid']) for r in rows)
     check(lid == 0.0, f'force_lid: the dry lid feels nothing ({lid:g} N/m)')
 

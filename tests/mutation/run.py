@@ -4,7 +4,7 @@ in each equation the code implements, the protocol's rejections and the
 coupler's failure handling? The faults are in tests/mutation/faults.py.
 
     nice -n 10 /usr/bin/python3 tests/mutation/run.py [--work DIR] [--only ID,ID]
-        [--redo] [--baseline] [--all-tests] [--table FILE] [--check]
+        [--redo] [--baseline] [--all-tests] [--hints-only] [--table FILE] [--check]
 
 It copies the repository (a clone of HEAD with the working tree's files laid
 over it: uncommitted changes count) to a scratch directory (default
@@ -25,6 +25,11 @@ tree it ran on. A rerun lays the working tree over the scratch copy again
 and skips the faults done, unless --redo (with --only: those faults);
 --baseline runs the baseline again (after a change to the tests). --table
 FILE writes the markdown table for docs/testing.md.
+--hints-only skips the suite's baseline and runs only each fault's hinted
+tests, on the unmodified tree first (a test failing there is left out) and
+then with the fault: minutes instead of the suite's ten, for checking new
+faults; a fault none of its hints catches is reported as survived, not run
+against the rest of the suite.
 --check only verifies that every fault's text occurs once in its file.
 Exit status: 0 if every fault was caught, 1 otherwise."""
 import argparse
@@ -156,11 +161,16 @@ def alternation(names):
     return '^(' + '|'.join(re.escape(n) for n in names) + ')$'
 
 
-def run_fault(f, src, build, log, baseline_bad, all_tests):
+def run_fault(f, src, build, log, baseline_bad, all_tests, hints_only=False):
     path = os.path.join(src, f['file'])
     text = open(path).read()
     if text.count(f['old']) != 1:
         return {'status': 'not applied', 'caught_by': []}
+    if hints_only:  # the hinted tests' own baseline, on the unmodified tree
+        hinted = [t for t in fast_tests(build) if re.search(f.get('hint', '$^'), t)]
+        if not hinted:
+            return {'status': 'not applied', 'caught_by': [], 'why': 'no hinted test'}
+        baseline_bad = set(failed(ctest(build, log, ['-R', alternation(hinted)])))
     t0 = time.time()
     try:
         with open(path, 'w') as fp:
@@ -175,7 +185,7 @@ def run_fault(f, src, build, log, baseline_bad, all_tests):
             r = ctest(build, log, ['-R', alternation(hinted)])
             ran.update(r)
             caught = failed(r)
-        if not caught:
+        if not caught and not hints_only:
             rest = [t for t in every if t not in ran]
             if rest:
                 extra = [] if all_tests else ['--stop-on-failure']
@@ -187,6 +197,8 @@ def run_fault(f, src, build, log, baseline_bad, all_tests):
     finally:
         with open(path, 'w') as fp:
             fp.write(text)
+        if hints_only:
+            build_tree(build, log)  # the next fault's baseline needs the clean build
 
 
 def table(results):
@@ -208,6 +220,8 @@ def main():
     ap.add_argument('--all-tests', action='store_true', help='every fast test for every fault')
     ap.add_argument('--redo', action='store_true', help='run faults already in results.json')
     ap.add_argument('--baseline', action='store_true', help='run the baseline again')
+    ap.add_argument('--hints-only', action='store_true',
+                    help="only each fault's hinted tests, with their own baseline")
     ap.add_argument('--table', help='write the markdown table to this file')
     ap.add_argument('--check', action='store_true', help='only check that the faults apply')
     a = ap.parse_args()
@@ -223,7 +237,10 @@ def main():
         sys.exit(f'mutation: the unmodified tree does not build, see {log}')
     state = json.load(open(res_path)) if os.path.exists(res_path) else {'faults': {}}
     rev = revision()
-    if 'baseline' not in state or a.baseline:
+    if a.hints_only:
+        state.setdefault('baseline', {'failed': [], 'tests': 0, 'revision': rev, 'seconds': 0,
+                                      'hints_only': True})
+    elif 'baseline' not in state or a.baseline:
         print(f'baseline: the fast suite on the unmodified tree ({rev}) ...', flush=True)
         t0 = time.time()
         r = ctest(build, log, FAST)
@@ -231,15 +248,19 @@ def main():
                              'seconds': round(time.time() - t0)}
         json.dump(state, open(res_path, 'w'), indent=1)
     base = state['baseline']
-    print(f"baseline: {base['tests']} fast tests in {base['seconds']} s; failing (left out): "
-          f"{base['failed'] or 'none'}", flush=True)
+    if a.hints_only:
+        print("baseline: each fault's hinted tests on the unmodified tree (--hints-only)",
+              flush=True)
+    else:
+        print(f"baseline: {base['tests']} fast tests in {base['seconds']} s; failing (left out): "
+              f"{base['failed'] or 'none'}", flush=True)
     only = set(a.only.split(',')) if a.only else None
     for f in FAULTS:
         if only and f['id'] not in only:
             continue
         if f['id'] in state['faults'] and not a.redo:
             continue
-        r = run_fault(f, src, build, log, set(base['failed']), a.all_tests)
+        r = run_fault(f, src, build, log, set(base['failed']), a.all_tests, a.hints_only)
         r['revision'] = rev
         state['faults'][f['id']] = r
         json.dump(state, open(res_path, 'w'), indent=1)

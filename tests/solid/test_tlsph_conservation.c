@@ -6,7 +6,8 @@
  *  - released from a 1% stretch + 0.5% shear without viscosity: the forces
  *    are the gradient of U + U_hg and the update is symplectic, so the
  *    leapfrog energy stays bounded (no growth) over 1e5 steps;
- *  - the same with viscosity (alpha = 1): the energy never rises and decays.
+ *  - the same with viscosity (alpha = 1): the energy never rises and decays;
+ *  - the fluid's loads change the momentum by their sum times the time.
  * With the argument "quadratic" the same runs with the second-order
  * correction (solid.tlsph.correction: quadratic). */
 #include <math.h>
@@ -54,6 +55,47 @@ static void momentum_test(void)
     CHECK(dl_max <= 1e-12 * lscale);
     /* the spin survives (viscosity does not damp rigid rotation) */
     CHECK(fabs(d.angular - d0.angular) < 1e-9 * fabs(d0.angular));
+    solid_tlsph_destroy(&m);
+}
+
+/* Eq. 49 in the TLSPH solid: the loads the fluid sends (solid_model_ops
+ * set_loads, N per metre of depth on the interface particles) change the
+ * body's momentum by exactly their sum times the time, in each direction:
+ * the internal forces are antisymmetric (above), so nothing else can. */
+static void loads_test(void)
+{
+    struct solid_scene sc;
+    tl_block_scene(&sc, 10, 6, 0.01, 1e8, 0.3, 0.9);
+    struct solid_tlsph *m = tl_make(&sc, 1.0, 0.05);
+    const struct solid_model_ops *ops = solid_model_find("tlsph");
+    CHECK(ops == &solid_tlsph_ops);
+    struct solid_iface f;
+    struct mps_err err = {0};
+    CHECK(ops->interface(m, 0.0, &f, &err) == MPS_OK);
+    CHECK(f.n == 2 * 10 + 2 * 6 - 4);
+    double(*force)[MPS_DIM] = calloc(f.n, sizeof *force);
+    double *pres = calloc(f.n, sizeof *pres);
+    CHECK(force && pres);
+    for (size_t k = 0; force && k < f.n; k++) {
+        force[k][0] = -1.5; /* N per metre of depth */
+        force[k][1] = 2.0;
+    }
+    struct solid_loads ld = {f.n, f.id, pres, (const double(*)[MPS_DIM])force};
+    CHECK(ops->set_loads(m, &ld, &err) == MPS_OK);
+    struct solid_tlsph_diag d0, d1;
+    solid_tlsph_diag(m, &d0);
+    const double dt = ops->stable_dt(m);
+    const int nsteps = 100;
+    for (int k = 0; k < nsteps; k++)
+        CHECK(ops->advance(m, dt, &err) == MPS_OK);
+    solid_tlsph_diag(m, &d1);
+    const double want[MPS_DIM] = {-1.5 * f.n * nsteps * dt, 2.0 * f.n * nsteps * dt};
+    printf("loads: momentum change %.6g, %.6g against the loads' %.6g, %.6g N s/m\n",
+           d1.momentum[0] - d0.momentum[0], d1.momentum[1] - d0.momentum[1], want[0], want[1]);
+    CHECK_NEAR(d1.momentum[0] - d0.momentum[0], want[0], 1e-9 * fabs(want[0]));
+    CHECK_NEAR(d1.momentum[1] - d0.momentum[1], want[1], 1e-9 * fabs(want[1]));
+    free(force);
+    free(pres);
     solid_tlsph_destroy(&m);
 }
 
@@ -110,6 +152,7 @@ int main(int argc, char **argv)
     tl_quadratic = argc > 1 && strcmp(argv[1], "quadratic") == 0;
     printf("correction: %s\n", tl_quadratic ? "quadratic" : "linear");
     momentum_test();
+    loads_test();
     double rise, final;
     /* Without viscosity at C = 0.5: a large-amplitude (1%) oscillation with
      * the high modes excited. At C = 0.7 (0.8) the energy stays within 4%
