@@ -364,7 +364,7 @@ static enum mps_status update_neighbours(struct fluid *f, struct mps_err *err)
  * given restitution (Koshizuka's collision model; fixed and solid particles
  * act as infinitely heavy). Computed from a frozen copy so the result does
  * not depend on loop order. */
-static long collide(struct fluid *f, double dt)
+long fluid_collide(struct fluid *f, double dt)
 {
     const double cd = f->prm.collision_dist * f->prm.dp, cd2 = cd * cd;
     const double e = f->prm.collision_restitution;
@@ -773,7 +773,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     if ((st = mps_nbr_list_filter(&f->nl_n, &f->nl, x, p->re_n * p->dp, err)))
         return st;
     mps_timer_switch(&f->timer, PH_PREDICT);
-    f->last.collisions = collide(f, dt);
+    f->last.collisions = fluid_collide(f, dt);
 
     /* Eq. 8 at x*, and the free-surface double check (paper 4.3), for the
      * PPE unknowns (f->unknown: which they are depends on fluid.wall_bc) */

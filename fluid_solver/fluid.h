@@ -185,6 +185,12 @@ void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows);
 /* Recomputes the type masks (has_p, is_fluid) after particle types change. */
 void fluid_update_masks(struct fluid *f);
 
+/* The collision model after the prediction (fluid.collision_distance,
+ * fluid.collision_restitution): on v* and x, over the neighbour list of the
+ * step; returns the number of colliding pairs. Public for the known-answer
+ * test. */
+long fluid_collide(struct fluid *f, double dt);
+
 /* The particle shifting at the end of a step (fluid.shifting, its weight
  * fluid.shifting_weight), over the neighbour list of the step; public for
  * the known-answer test. */

@@ -4,6 +4,8 @@
  *     water stays still (cases/hydrostatic);
  *   - the free-surface closure makes the PPE's Laplacian of a pressure
  *     linear in depth exact in the rows under a flat surface;
+ *   - the collision model keeps a pair's momentum and reverses its approach
+ *     with the restitution;
  *   - first step of the dam break, incompressible (alpha = 0): the pressure
  *     of the potential-flow problem at t = 0 (Laplace, P = 0 on the free
  *     faces, dP/dn = rho g.n on the walls), reference from a finite-difference
@@ -430,6 +432,64 @@ static void test_ppe_terms(void)
     f->rho_inertial = rho;
     free(rhs0);
     free(diag);
+    fluid_destroy(&f);
+}
+
+/* The collision model (fluid_collide, Koshizuka's): two fluid particles of
+ * equal mass closer than collision_distance dp that approach share the
+ * impulse -(1 + e) v_n / 2 along their line, so their momentum is kept and
+ * their normal approach speed v_n comes out as -e v_n; a separating pair,
+ * and a pair further apart, are left alone; the positions move by dt times
+ * the velocity change. The still lattice after one step, every v* zeroed,
+ * one particle moved to 0.6 dp from its right neighbour and pushed at it. */
+static void test_collision(void)
+{
+    const char *sets[] = {"dp=0.01"};
+    struct fluid *f = make_stepped("cases/hydrostatic/case.yml", sets, 1, 1);
+    if (!f)
+        return;
+    const double dp = 0.01, dt = 1e-3, e = f->prm.collision_restitution;
+    CHECK(f->prm.collision_dist > 0.6 && e > 0.0);
+    size_t i = nearest_fluid(f, 0.195, 0.105), j = nearest_fluid(f, 0.205, 0.105);
+    CHECK(i != j && fabs(f->x[j][0] - f->x[i][0] - dp) < 1e-4 * dp);
+    for (size_t k = 0; k < f->nfluid; k++)
+        f->vstar[k][0] = f->vstar[k][1] = 0.0;
+    f->x[i][0] = f->x[j][0] - 0.6 * dp; /* within the Verlet skin of its list */
+    f->x[i][1] = f->x[j][1] + 0.1 * dp;
+    double n[2] = {f->x[j][0] - f->x[i][0], f->x[j][1] - f->x[i][1]};
+    double r = hypot(n[0], n[1]);
+    n[0] /= r;
+    n[1] /= r;
+    const double u[2] = {0.2, 0.05}; /* m/s, towards j */
+    f->vstar[i][0] = u[0];
+    f->vstar[i][1] = u[1];
+    double xi0[2] = {f->x[i][0], f->x[i][1]}, xj0[2] = {f->x[j][0], f->x[j][1]};
+    long pairs = fluid_collide(f, dt);
+    const double vn = u[0] * n[0] + u[1] * n[1], J = 0.5 * (1.0 + e) * vn;
+    double worst = 0.0, vn_after = 0.0;
+    for (int d = 0; d < 2; d++) {
+        double want_i = u[d] - J * n[d], want_j = J * n[d];
+        worst = fmax(worst, fabs(f->vstar[i][d] - want_i));
+        worst = fmax(worst, fabs(f->vstar[j][d] - want_j));
+        worst = fmax(worst, fabs(f->x[i][d] - xi0[d] - dt * (want_i - u[d])));
+        worst = fmax(worst, fabs(f->x[j][d] - xj0[d] - dt * want_j));
+        vn_after += (f->vstar[i][d] - f->vstar[j][d]) * n[d];
+    }
+    double others = 0.0;
+    for (size_t k = 0; k < f->nfluid; k++)
+        if (k != i && k != j)
+            others = fmax(others, hypot(f->vstar[k][0], f->vstar[k][1]));
+    printf("collision: %ld pair(s), approach %.3f m/s -> %.4f m/s (-e v_n = %.4f), |v - want| "
+           "<= %.3g, others moved %.3g\n", pairs, vn, vn_after, -e * vn, worst, others);
+    CHECK(pairs == 2); /* the pair, seen from each side */
+    CHECK(worst <= 1e-14);
+    CHECK(others == 0.0);
+    /* separating: untouched */
+    f->vstar[i][0] = -u[0];
+    f->vstar[i][1] = -u[1];
+    f->vstar[j][0] = f->vstar[j][1] = 0.0;
+    CHECK(fluid_collide(f, dt) == 0);
+    CHECK(f->vstar[i][0] == -u[0] && f->vstar[j][0] == 0.0);
     fluid_destroy(&f);
 }
 
@@ -1325,6 +1385,7 @@ int main(int argc, char **argv)
     test_droplet_step();
     test_ppe_terms();
     test_surface_closure();
+    test_collision();
     test_divergence_stencil();
     test_divergence_slip();
     test_verlet_list();

@@ -381,6 +381,11 @@ FAULTS = [
       new='double dw_r = smooth ? 2.2 * (1.0 - 1.0 / (ir * re)) / re * ir : re * ir * ir * ir;',
       what="the smooth weight's slope 10% steep (the shift 10% large off the lattice)",
       hint='test_fluid_step'),
+    F(id='collision_impulse', eq='collision model (Koshizuka)', file='fluid_solver/fluid.c',
+      old='acc[d] -= share * (1.0 + e) * vn * dx[d] / r;',
+      new='acc[d] -= 1.1 * share * (1.0 + e) * vn * dx[d] / r;',
+      what="the collision's impulse 10% strong (momentum no longer kept, the rebound too fast)",
+      hint='test_fluid_step'),
     # ---- walls: pressure extrapolation and the free-surface closure (fluid_ppe.c) ----
     F(id='wall_extrapolation_weak', eq='wall pressure (Adami et al. 2012)',
       file='fluid_solver/fluid_ppe.c',
