@@ -107,6 +107,17 @@ static size_t nearest_fluid(const struct fluid *f, double x, double y)
     return best;
 }
 
+/* The particle of each PPE row (f->row inverted), malloc'ed; NULL if out of
+ * memory. */
+static size_t *row_particles(const struct fluid *f)
+{
+    size_t *part = malloc((size_t)(f->nrows > 0 ? f->nrows : 1) * sizeof *part);
+    for (size_t i = 0; part && i < f->ps.n; i++)
+        if (f->row[i] >= 0)
+            part[f->row[i]] = i;
+    return part;
+}
+
 static void test_still_water(void)
 {
     const char *sets[] = {"dp=0.01"};
@@ -323,11 +334,8 @@ static void test_ppe_terms(void)
             }
         }
     const double lap_c = 2.0 * MPS_DIM / ((sr2w / sw) * sw);
-    size_t *part = malloc((size_t)n * sizeof *part);
+    size_t *part = row_particles(f);
     CHECK(part != NULL);
-    for (size_t i = 0; part && i < f->ps.n; i++)
-        if (f->row[i] >= 0)
-            part[f->row[i]] = i;
     double aworst = 0.0, abig = 0.0;
     for (int r = 0; part && r < n; r++)
         for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++) {
@@ -520,11 +528,8 @@ static void test_surface_closure(void)
         CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
         const double comp = f->prm.rho * f->prm.alpha / (dt * dt);
         const int n = f->nrows;
-        size_t *part = malloc((size_t)(n > 0 ? n : 1) * sizeof *part);
+        size_t *part = row_particles(f);
         CHECK(part != NULL && n > 0);
-        for (size_t i = 0; part && i < f->ps.n; i++)
-            if (f->row[i] >= 0)
-                part[f->row[i]] = i;
         for (int r = 0; part && r < n; r++) {
             size_t i = part[r];
             double xi = f->x[i][0], yi = f->x[i][1];
@@ -733,14 +738,11 @@ static void test_simd_paths(void)
 static int shadow_cross_entries(const struct fluid *f, int *asym)
 {
     const double xl = 0.294, xr = 0.306, top = 0.084;
-    int *part = malloc((size_t)(f->nrows > 0 ? f->nrows : 1) * sizeof *part);
+    size_t *part = row_particles(f);
     int cross = 0;
     *asym = 0;
     if (!part)
         return -1;
-    for (size_t i = 0; i < f->ps.n; i++)
-        if (f->row[i] >= 0)
-            part[f->row[i]] = (int)i;
     for (int r = 0; r < f->nrows; r++) {
         const double *xi = f->x[part[r]];
         for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++) {

@@ -54,4 +54,33 @@ static inline double total_energy(const struct solid_mps *m)
     return d.kinetic + d.elastic + d.gravity;
 }
 
+/* The same load (fx, fy), N per metre of depth, on every particle of the
+ * model's interface (the surface: depth 0), through its function table, as
+ * the coupler sends the fluid's; f gets the interface. The model keeps a copy
+ * of the loads. */
+static inline enum mps_status uniform_surface_loads(const struct solid_model_ops *ops, void *m,
+                                                    double fx, double fy, struct solid_iface *f,
+                                                    struct mps_err *err)
+{
+    enum mps_status st = ops->interface(m, 0.0, f, err);
+    if (st != MPS_OK)
+        return st;
+    double(*force)[MPS_DIM] = calloc(f->n ? f->n : 1, sizeof *force);
+    double *pres = calloc(f->n ? f->n : 1, sizeof *pres);
+    if (!force || !pres) {
+        free(force);
+        free(pres);
+        return mps_err_set(err, MPS_ENOMEM, "test: out of memory for the loads");
+    }
+    for (size_t k = 0; k < f->n; k++) {
+        force[k][0] = fx;
+        force[k][1] = fy;
+    }
+    struct solid_loads ld = {f->n, f->id, pres, (const double(*)[MPS_DIM])force};
+    st = ops->set_loads(m, &ld, err);
+    free(force);
+    free(pres);
+    return st;
+}
+
 #endif

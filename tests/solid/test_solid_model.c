@@ -107,14 +107,8 @@ static void loads_test(void)
     CHECK(solid_model_find("nosuch") == NULL);
     struct solid_iface f;
     struct mps_err err = {0};
-    CHECK(ops->interface(m, 0.0, &f, &err) == MPS_OK);
+    CHECK(uniform_surface_loads(ops, m, 0.0, 2.0, &f, &err) == MPS_OK); /* N per metre depth */
     CHECK(f.n == 2 * 10 + 2 * 6 - 4);
-    double(*force)[MPS_DIM] = calloc(f.n, sizeof *force);
-    double *pres = calloc(f.n, sizeof *pres);
-    for (size_t k = 0; k < f.n; k++)
-        force[k][1] = 2.0; /* N per metre depth */
-    struct solid_loads ld = {f.n, f.id, pres, (const double(*)[MPS_DIM])force};
-    CHECK(ops->set_loads(m, &ld, &err) == MPS_OK);
     struct solid_mps_diag d0, d1;
     solid_mps_diag(m, &d0);
     double dt = ops->stable_dt(m);
@@ -124,11 +118,10 @@ static void loads_test(void)
     CHECK_NEAR(d1.momentum[1] - d0.momentum[1], 2.0 * f.n * 100 * dt, 1e-12);
     CHECK_NEAR(d1.momentum[0] - d0.momentum[0], 0.0, 1e-12);
     int bad_id = 100000;
-    struct solid_loads bad = {1, &bad_id, pres, (const double(*)[MPS_DIM])force};
+    double bad_force[1][MPS_DIM] = {{0.0, 2.0}}, bad_pres[1] = {0.0};
+    struct solid_loads bad = {1, &bad_id, bad_pres, (const double(*)[MPS_DIM])bad_force};
     CHECK(ops->set_loads(m, &bad, &err) == MPS_EINPUT);
     printf("loads: %s\n", err.msg);
-    free(force);
-    free(pres);
     solid_mps_destroy(&m);
 
     /* interface with depth: 12 x 10 block, rings 1 and 2 within 2 dp */
