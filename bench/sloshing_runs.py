@@ -186,6 +186,9 @@ def analyse(name, spec, out):
     res['message'] = summ.get('message', '')
     res['t_reached'] = summ['simulated_time']
     res['wall'] = summ['wall_seconds']
+    # a resumed run's wall time is its last segment's, from this time on
+    res['resumed_at'] = (summ.get('restart') or {}).get('time')
+    res['git_rev'] = summ.get('git_rev', '')
     res['steps'] = summ['coupling_steps']
     res['messaging'] = summ.get('messaging_fraction', float('nan'))
     res['host'] = summ.get('host', '')
@@ -254,8 +257,9 @@ def table(rows):
                                             f" ({r['energy_ratio']:.2f})"))
         plane = '' if r['plane'] == 'stress' else ', plane strain'
         motion = '' if r['motion'] == 'sinusoid' else ', measured roll'
+        resumed = '' if r.get('resumed_at') is None else f" from {r['resumed_at']:.2f} s"
         out.append(f"| {r['name']} | {r['model']}{plane}{motion} | {r['dp'] * 1e3:g} mm | {reached} | "
-                   f"{metric} | {err} | {per} | {cv} | {stab} | {fmt_time(r['wall'])} "
+                   f"{metric} | {err} | {per} | {cv} | {stab} | {fmt_time(r['wall'])}{resumed} "
                    f"({r['load']:.1f}) | {r['n_fluid']:,} / {r['n_solid_iface']} | {r['steps']:,} | "
                    f"{r['substeps']:,} |")
     return '\n'.join(out)
@@ -283,8 +287,11 @@ def phases(rows, out):
             sp['messaging'] = w - sp['fluid'] - sp['solid']
         ph = fl['phase_seconds']
         tot = sum(ph.values())
+        # resumed: the wall time covers the last segment, the steps the whole run
+        per_step = ('- (resumed)' if r.get('resumed_at') is not None
+                    else f"{1e3 * w / max(r['steps'], 1):.1f} ms")
         out_rows.append(
-            f"| {r['name']} | {r['steps']:,} | {1e3 * w / max(r['steps'], 1):.1f} ms | "
+            f"| {r['name']} | {r['steps']:,} | {per_step} | "
             f"{100 * sp['fluid'] / w:.0f}% / {100 * sp['solid'] / w:.0f}% / "
             f"{100 * sp['messaging'] / w:.0f}% | {fl['ns_per_particle_step']:.0f} | "
             + ' / '.join(f"{100 * ph[k] / tot:.0f}%" for k in names)
@@ -388,7 +395,9 @@ def main():
         for n in names:
             do_run(n, runs[n], a.out, a.force, a.set, a.coupler)
     rows = [analyse(n, runs[n], a.out) for n in names]
-    text = table(rows)
+    revs = sorted({r.get('git_rev', '') for r in rows if 'missing' not in r} - {''})
+    text = (f"Written by bench/sloshing_runs.py on {time.strftime('%Y-%m-%d')} from the runs in "
+            f"{a.out} (builds {', '.join(revs) or 'unknown'}).\n\n" + table(rows))
     extra = table_vs_sinusoid(rows, a.out, a.compare_window) + [phases(rows, a.out)]
     if extra:
         text += '\n\n' + '\n\n'.join(extra)
