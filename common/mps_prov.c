@@ -6,6 +6,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "mps_case.h"
 #include "mps_host.h"
 #include "mps_version.h"
 
@@ -44,6 +45,16 @@ void mps_prov_init(int argc, char *const *argv)
     command[0] = '\0';
     for (int i = 0; i < argc; i++)
         append_word(command, sizeof command, &at, argv[i]);
+    /* the record goes into the resolved case, which is UTF-8: a byte of
+     * anything else (a bad --set, which the case then reports by its key)
+     * is recorded as '?' */
+    for (unsigned char *p = (unsigned char *)command; *p;) {
+        size_t n = mps_utf8_seq(p);
+        if (!n)
+            *p++ = '?';
+        else
+            p += n;
+    }
     if (gethostname(hostname, sizeof hostname) != 0)
         snprintf(hostname, sizeof hostname, "unknown");
     hostname[sizeof hostname - 1] = '\0';

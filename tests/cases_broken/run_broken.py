@@ -37,6 +37,13 @@ def generate(name, tmp):
     return path
 
 
+def raw_bytes(arg):
+    """The argument with each \\xNN written as that byte, so a line of the
+    manifest (text) can pass bytes that are not UTF-8."""
+    return re.sub(rb'\\x([0-9a-fA-F]{2})', lambda m: bytes([int(m.group(1), 16)]),
+                  os.fsencode(arg))
+
+
 def main():
     tmp = tempfile.mkdtemp(prefix='broken_')
     out = os.path.join(tmp, 'out')
@@ -53,7 +60,8 @@ def main():
         pattern = re.compile(regex.replace('@', re.escape(path)))
         for prog in PROGRAMS[progs]:
             runs += 1
-            cmd = [os.path.join(BIN, prog), path, '--out', out] + shlex.split(extra)
+            cmd = [os.path.join(BIN, prog), path, '--out', out] + [
+                raw_bytes(a) for a in shlex.split(extra)]
             try:
                 p = subprocess.run(cmd, capture_output=True, text=True, timeout=30,
                                    errors='replace')

@@ -326,6 +326,51 @@ static void test_ignore(void)
     mps_case_destroy(&c);
 }
 
+/* The UTF-8 check every key and value passes (the resolved case is YAML):
+ * each kind of malformed sequence, and the longest well-formed ones. */
+static void test_utf8(void)
+{
+    static const struct {
+        const char *s;
+        size_t n;
+    } seqs[] = {
+        {"a", 1},
+        {"\xc3\xa9", 2},         /* U+00E9 */
+        {"\xe2\x82\xac", 3},     /* U+20AC */
+        {"\xf0\x9f\x98\x80", 4}, /* U+1F600 */
+        {"\xf4\x8f\xbf\xbf", 4}, /* U+10FFFF, the last code point */
+        {"\xff", 0},             /* never a lead byte */
+        {"\x80", 0},             /* a continuation byte first */
+        {"\xc3", 0},             /* cut short */
+        {"\xc3\x41", 0},         /* not a continuation */
+        {"\xc0\x80", 0},         /* overlong NUL */
+        {"\xe0\x80\xaf", 0},     /* overlong '/' */
+        {"\xed\xa0\x80", 0},     /* a surrogate, U+D800 */
+        {"\xf4\x90\x80\x80", 0}, /* past U+10FFFF */
+        {"", 0},
+    };
+    for (size_t i = 0; i < sizeof seqs / sizeof seqs[0]; i++)
+        CHECK(mps_utf8_seq((const unsigned char *)seqs[i].s) == seqs[i].n);
+
+    /* by key, in a declared string, an undeclared key under an ignored
+     * prefix, and a key itself; the bytes shown as \xNN */
+    const char *base = "dp: 1\nend_time: 1\n";
+    const char *s1[] = {"probes.0=a\xff"};
+    expect_error(base, s1, 1, "probes.0 = a\\xff: must be UTF-8 text", NULL, NULL);
+    const char *s2[] = {"solid.note=caf\xe9"};
+    expect_error(base, s2, 1, "solid.note = caf\\xe9: must be UTF-8 text", NULL, NULL);
+    const char *s3[] = {"solid.\xc0\x80=1"};
+    expect_error(base, s3, 1, "solid.\\xc0\\x80 = 1: must be UTF-8 text", NULL, NULL);
+    const char *s4[] = {"description=caf\xc3\xa9 \xe2\x82\xac"}; /* well formed */
+    struct mps_err err;
+    struct mps_case *c = load(write_tmp(base), s4, 1, &err);
+    CHECK(c != NULL);
+    char *y = c ? mps_case_resolved_yaml(c) : NULL;
+    CHECK(y && strstr(y, "caf\xc3\xa9 \xe2\x82\xac"));
+    free(y);
+    mps_case_destroy(&c);
+}
+
 static void test_round_trip(void)
 {
     struct mps_err err;
@@ -462,6 +507,7 @@ int main(void)
     test_set();
     test_errors();
     test_ignore();
+    test_utf8();
     test_round_trip();
     test_aborts();
     for (int i = 0; i < ntmp; i++)
