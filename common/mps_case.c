@@ -208,6 +208,12 @@ enum mps_status mps_case_load(struct mps_case **out, const char *path,
                               const char *const *ignore_prefixes, struct mps_err *err)
 {
     *out = NULL;
+    if (!mps_utf8_valid(path)) { /* it is written into the run's YAML and JSON records */
+        char shown[1024];
+        return mps_err_set(err, MPS_EINPUT, "%s: the case file's path must be UTF-8 text "
+                           "(it is recorded in the run's YAML and JSON files)",
+                           mps_utf8_escaped(path, shown, sizeof shown));
+    }
     struct mps_case *c = calloc(1, sizeof *c);
     if (!c)
         return mps_err_set(err, MPS_ENOMEM, "%s: out of memory", path);
@@ -452,22 +458,4 @@ const char *mps_case_path(const struct mps_case *c)
 const char *mps_case_dir(const struct mps_case *c)
 {
     return c->dir;
-}
-
-size_t mps_utf8_seq(const unsigned char *p)
-{
-    int n = *p < 0x80 ? 0 : (*p & 0xe0) == 0xc0 ? 1 : (*p & 0xf0) == 0xe0 ? 2
-          : (*p & 0xf8) == 0xf0 ? 3 : -1;
-    if (!*p || n < 0 || (n == 1 && *p < 0xc2) || (n == 3 && *p > 0xf4))
-        return 0;
-    unsigned long cp = *p & (0x7fu >> n);
-    for (int k = 1; k <= n; k++) {
-        if ((p[k] & 0xc0) != 0x80)
-            return 0;
-        cp = cp << 6 | (p[k] & 0x3fu);
-    }
-    if ((n == 2 && (cp < 0x800 || (cp >= 0xd800 && cp <= 0xdfff))) ||
-        (n == 3 && (cp < 0x10000 || cp > 0x10ffff)))
-        return 0;
-    return (size_t)n + 1;
 }

@@ -14,6 +14,7 @@
 #include <stddef.h>
 
 #include "mps_err.h"
+#include "mps_utf8.h"
 
 enum mps_key_type {
     MPS_KEY_DOUBLE,
@@ -91,11 +92,6 @@ int mps_case_count(const struct mps_case *c, const char *fmt, ...)
 /* "case.yml:14" (or "--set" or "default") for the key, for error messages from
  * checks that span several keys, e.g. a fluid block outside the tank. */
 const char *mps_case_where(const struct mps_case *c, const char *key);
-
-/* The length of the well-formed UTF-8 sequence at p (1-4 bytes; no overlong
- * forms, surrogates or code points past U+10FFFF), 0 if there is none. A
- * case's strings must be UTF-8: its resolved copy is YAML. */
-size_t mps_utf8_seq(const unsigned char *p);
 
 /* Builds an input error "WHERE: KEY = VALUE: problem" for key, as the loader
  * does, for semantic checks made by the solvers. Returns MPS_EINPUT. */

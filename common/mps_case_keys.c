@@ -9,38 +9,6 @@
 #include <string.h>
 #include <strings.h>
 
-static int utf8_valid(const char *s)
-{
-    for (const unsigned char *p = (const unsigned char *)s; *p;) {
-        size_t n = mps_utf8_seq(p);
-        if (!n)
-            return 0;
-        p += n;
-    }
-    return 1;
-}
-
-/* s with each byte that is not UTF-8 written as \xNN, so the message that
- * reports it is text and shows which bytes */
-static const char *utf8_escaped(const char *s, char *buf, size_t n)
-{
-    size_t at = 0;
-    for (const unsigned char *p = (const unsigned char *)s; *p && at + 5 < n;) {
-        size_t k = mps_utf8_seq(p);
-        if (!k) {
-            at += (size_t)snprintf(buf + at, n - at, "\\x%02x", *p++);
-            continue;
-        }
-        if (at + k + 1 > n)
-            break;
-        memcpy(buf + at, p, k);
-        at += k;
-        p += k;
-    }
-    buf[at] = '\0';
-    return buf;
-}
-
 /* ---- values ---- */
 
 const char *case_shown(const char *v)
@@ -302,12 +270,12 @@ static void check_keys(struct mps_case *c, struct errs *es)
          * a key or value that is not could be read but not written back,
          * and this holds under an ignored prefix too (another program's
          * section, copied through) */
-        if (!utf8_valid(e->key) || !utf8_valid(e->val)) {
+        if (!mps_utf8_valid(e->key) || !mps_utf8_valid(e->val)) {
             char where[KEY_MAX + 64], key[KEY_MAX * 4], val[256];
             case_add_err(es, "%s: %s = %s: must be UTF-8 text",
-                         utf8_escaped(e->where, where, sizeof where),
-                         utf8_escaped(e->key, key, sizeof key),
-                         utf8_escaped(case_shown(e->val), val, sizeof val));
+                         mps_utf8_escaped(e->where, where, sizeof where),
+                         mps_utf8_escaped(e->key, key, sizeof key),
+                         mps_utf8_escaped(case_shown(e->val), val, sizeof val));
             continue;
         }
         /* A declared key is validated even under an ignored prefix. */

@@ -245,9 +245,32 @@ enum mps_status case_read_origins(struct mps_case *c, struct mps_err *err)
     return st;
 }
 
+/* A path key's value is written absolute (absolute_path), and YAML is UTF-8:
+ * a case in a directory whose name is not would give a resolved case that
+ * cannot be written, so that is an input error naming the key. */
+static enum mps_status check_absolute_paths(const struct mps_case *c, struct mps_err *err)
+{
+    for (int i = 0; i < c->n; i++) {
+        char *abs = absolute_path(c, &c->e[i]);
+        if (abs && !mps_utf8_valid(abs)) {
+            char shown[1024];
+            mps_err_set(err, MPS_EINPUT, "%s: %s = %s: its absolute path %s must be UTF-8 "
+                        "text (the resolved case is YAML)", c->e[i].where, c->e[i].key,
+                        c->e[i].val, mps_utf8_escaped(abs, shown, sizeof shown));
+            free(abs);
+            return MPS_EINPUT;
+        }
+        free(abs);
+    }
+    return MPS_OK;
+}
+
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
                                         const char *comment, struct mps_err *err)
 {
+    enum mps_status pst = check_absolute_paths(c, err);
+    if (pst)
+        return pst;
     char *y = mps_case_resolved_yaml(c);
     char *tmp = case_xprintf("%s.tmp", path);
     if (!y || !tmp) {

@@ -4,6 +4,8 @@
 #include <math.h>
 #include <stdlib.h>
 
+#include "mps_utf8.h"
+
 #define MAX_DEPTH ((int)(sizeof ((struct mps_json *)0)->first / sizeof(int)) - 1)
 
 /* Newline and two spaces per level. */
@@ -18,6 +20,16 @@ static void string(FILE *f, const char *s)
 {
     fputc('"', f);
     for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        size_t k = mps_utf8_seq(p);
+        if (k > 1) { /* UTF-8 passes through */
+            fwrite(p, 1, k, f);
+            p += k - 1;
+            continue;
+        }
+        if (k == 0) { /* JSON is UTF-8: a stray byte (a path, a peer's text) becomes U+FFFD */
+            fputs("\\ufffd", f);
+            continue;
+        }
         switch (*p) {
         case '"': fputs("\\\"", f); break;
         case '\\': fputs("\\\\", f); break;
@@ -30,7 +42,7 @@ static void string(FILE *f, const char *s)
             if (*p < 0x20)
                 fprintf(f, "\\u%04x", *p);
             else
-                fputc(*p, f); /* UTF-8 passes through */
+                fputc(*p, f);
         }
     }
     fputc('"', f);

@@ -8,6 +8,7 @@
 
 #include "mps_case.h"
 #include "mps_host.h"
+#include "mps_utf8.h"
 #include "mps_version.h"
 
 static char command[4096], hostname[256], host[256], started[32];

@@ -44,6 +44,7 @@
 #include "mps_prov.h"
 #include "mps_restart.h"
 #include "mps_timer.h"
+#include "mps_utf8.h"
 #include "mps_version.h"
 #include "proto_link.h"
 #include "scene_check.h"
@@ -1330,6 +1331,14 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
     char abs_out[4096];
     if (!mps_realpath(c->out, abs_out, sizeof abs_out))
         return mps_err_set(err, MPS_EIO, "%s: %s", c->out, strerror(errno));
+    /* the solvers are sent it in CONFIG, whose text frame is UTF-8
+     * (PROTOCOL.md); the path as given was checked in main, this is the
+     * working directory's part */
+    char shown[1024];
+    if (!mps_utf8_valid(abs_out))
+        return mps_err_set(err, MPS_EINPUT, "--out %s: the output directory's absolute path "
+                           "%s must be UTF-8 text (the solvers are sent it in the protocol's "
+                           "text)", c->out, mps_utf8_escaped(abs_out, shown, sizeof shown));
     snprintf(c->rec.path, sizeof c->rec.path, "%s/case_resolved.yml", abs_out);
     /* written now, so a run that fails to start leaves it too; rewritten as
      * each solver says hello (coupler_record_hello) */
@@ -1523,6 +1532,16 @@ int main(int argc, char **argv)
                       c.restart);
     }
     c.out = cli.out_dir;
+    if (c.out && !mps_utf8_valid(c.out)) {
+        /* refused before anything is made or written there: the solvers
+         * are sent it in CONFIG, whose text frame is UTF-8 (PROTOCOL.md) */
+        char shown[1024];
+        fprintf(stderr, "coupler: --out %s: the output directory's path must be UTF-8 text "
+                "(the solvers are sent it in the protocol's text)\n",
+                mps_utf8_escaped(c.out, shown, sizeof shown));
+        mps_ckpt_free(&c.disk);
+        return mps_status_exit_code(MPS_EINPUT);
+    }
     c.quiet = cli.quiet;
     c.wall0 = mps_wall_seconds();
     c.p[FLUID].name = "fluid";

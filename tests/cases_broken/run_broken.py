@@ -20,8 +20,13 @@ PROGRAMS = {'all': ['coupler', 'fluid_solver', 'solid_solver'],
 
 def generate(name, tmp):
     """Files not worth committing, made here: a file over the 1 MiB cap, a
-    file of 10001 keys, a directory."""
+    file of 10001 keys, a directory, a good case whose name is not UTF-8."""
     path = os.path.join(tmp, name)
+    if name == 'not_utf8_name.yml':  # caf\xe9.yml: Latin-1 bytes, as an old file system has them
+        path = os.path.join(tmp, os.fsdecode(b'caf\xe9.yml'))
+        with open(path, 'w') as f:
+            f.write('dp: 0.01\nend_time: 0.1\nfluid:\n  tank: {width: 0.5, height: 0.4}\n'
+                    '  blocks:\n    - {x0: 0.0, y0: 0.0, x1: 0.2, y1: 0.2}\n')
     if name == 'large.yml':
         with open(path, 'w') as f:
             f.write('dp: 0.01\nend_time: 0.1\ndescription: "')

@@ -4,6 +4,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -26,6 +27,7 @@ static const struct mps_key_spec test_keys[] = {
      MPS_KEY_REQUIRED | MPS_KEY_NO_LO | MPS_KEY_NO_HI, NULL, "m", "block right edge"},
     {"fluid.blocks.*.kind", MPS_KEY_ENUM, "water", 0, 0, 0, "water|oil", "", "liquid"},
     {"probes.*", MPS_KEY_STRING, NULL, 0, 0, 0, NULL, "", "probe name"},
+    {"fluid.table", MPS_KEY_STRING, "", 0, 0, MPS_KEY_PATH, NULL, "", "a file"},
     {.name = NULL},
 };
 
@@ -369,6 +371,34 @@ static void test_utf8(void)
     CHECK(y && strstr(y, "caf\xc3\xa9 \xe2\x82\xac"));
     free(y);
     mps_case_destroy(&c);
+
+    /* a case file's path that is not UTF-8 (it goes into the records) */
+    char dir[] = "/tmp/test_case_XXXXXX", bad_dir[64], bad_path[96], cwd[4096];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(bad_dir, sizeof bad_dir, "%s/d\xe9", dir);
+    CHECK(mkdir(bad_dir, 0700) == 0);
+    snprintf(bad_path, sizeof bad_path, "%s/case.yml", bad_dir);
+    FILE *f = fopen(bad_path, "w");
+    CHECK(f && fputs("dp: 1\nend_time: 1\nfluid: {table: t.csv}\n", f) >= 0 && fclose(f) == 0);
+    c = (struct mps_case *)1;
+    CHECK(mps_case_load(&c, bad_path, NULL, 0, tables, 2, ignore, &err) == MPS_EINPUT && !c);
+    CHECK(strstr(err.msg, "/d\\xe9/case.yml: the case file's path must be UTF-8 text"));
+    /* loaded by a relative path from inside that directory, the path key's
+     * absolute form is not UTF-8: refused by key when the resolved case is
+     * written, not written half */
+    CHECK(getcwd(cwd, sizeof cwd) && chdir(bad_dir) == 0);
+    c = load("case.yml", NULL, 0, &err);
+    char out[96];
+    snprintf(out, sizeof out, "%s/resolved.yml", dir);
+    CHECK(c && mps_case_write_resolved(c, out, NULL, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "case.yml:3: fluid.table = t.csv: its absolute path ") &&
+          strstr(err.msg, "/d\\xe9/t.csv must be UTF-8 text"));
+    CHECK(access(out, F_OK) != 0);
+    mps_case_destroy(&c);
+    CHECK(chdir(cwd) == 0);
+    remove(bad_path);
+    rmdir(bad_dir);
+    rmdir(dir);
 }
 
 static void test_round_trip(void)

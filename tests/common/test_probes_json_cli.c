@@ -77,6 +77,9 @@ static void test_json(void)
     struct mps_json j;
     mps_json_begin(&j, f);
     mps_json_str(&j, "name", "quote\" back\\ nl\n tab\t ctl\x01 utf8 \xc3\xa9");
+    /* JSON is UTF-8: a stray byte (a path, a peer's text) becomes U+FFFD,
+     * a cut sequence too, and what follows is kept */
+    mps_json_str(&j, "stray", "caf\xe9.yml \xe2\x82 \xf0\x9f\x98\x80");
     mps_json_num(&j, "dt", 0.1);
     mps_json_num(&j, "third", 1.0 / 3.0);
     mps_json_num(&j, "nan", 0.0 / 0.0);
@@ -102,6 +105,7 @@ static void test_json(void)
     char *t = slurp(path);
     CHECK_STR(t, "{\n"
                  "  \"name\": \"quote\\\" back\\\\ nl\\n tab\\t ctl\\u0001 utf8 \xc3\xa9\",\n"
+                 "  \"stray\": \"caf\\ufffd.yml \\ufffd\\ufffd \xf0\x9f\x98\x80\",\n"
                  "  \"dt\": 0.1,\n"
                  "  \"third\": 0.33333333333333331,\n"
                  "  \"nan\": null,\n"
