@@ -17,9 +17,11 @@
  *
  * Convergence (coupling.implicit.tolerance, abs_tolerance): the step has
  * converged when the positions the solid returned differ from those the
- * fluid was given by at most tol times the interface's displacement from its
- * initial positions plus atol, both as root mean squares over the interface
- * particles: rms|x_k - x~_k| <= tol rms|x_k - x_0| + atol.
+ * fluid was given by at most tol times the interface's displacement over the
+ * step plus atol dt (atol a velocity), both as root mean squares over the
+ * interface particles: rms|x_k - x~_k| <= tol rms|x_k - x_start| + atol dt.
+ * (The displacement from the initial positions, rms|x_k - x_0|, is measured
+ * and logged, not tested: docs/coupling.md says why.)
  *
  * The first input of a step is the linear extrapolation of the positions at
  * the last two steps' starts, x_n + (x_n - x_(n-1)) dt_n / dt_(n-1) (the

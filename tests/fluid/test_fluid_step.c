@@ -603,6 +603,52 @@ static void test_surface_double_check(void)
     fluid_destroy(&f);
 }
 
+/* The empty-side scan's two branches (fluid.surface_scan_density, and the
+ * wall exemption: fluid.c, surface_scan): the dam-break column at dp = 1 cm
+ * stretched by 10% from the corner, so every inner particle is a candidate
+ * of the double check (neighbours at 1.1, 1.56 dp: n = 0.77 n0, 8 of 12
+ * within re_n) and sparser than the scan's 0.9 n0. Away from the walls the
+ * lattice is symmetric and such spray-like candidates are not scanned: they
+ * stay on the surface. Within re_n of the floor or the left wall the wall,
+ * not spray, thins the neighbourhood: they are scanned, find water a
+ * spacing away on their empty-looking side, and keep their PPE rows. */
+static void test_surface_scan_walls(void)
+{
+    const char *sets[] = {"dp=0.01"};
+    struct fluid *f = make("cases/dambreak/case.yml", sets, 1);
+    CHECK(f != NULL);
+    if (!f)
+        return;
+    const double s = 1.1, dp = 0.01, w = s * 0.146, h = s * 0.292;
+    for (size_t i = 0; i < f->nfluid; i++)
+        for (int d = 0; d < MPS_DIM; d++)
+            f->x[i][d] *= s;
+    CHECK(step(f, 1e-5) == MPS_OK);
+    const double nlim = f->prm.beta1 * f->n0, clim = f->prm.beta2 * f->count0;
+    const double nmin = f->prm.surface_scan_density * f->n0;
+    size_t wall_cand = 0, wall_flagged = 0, free_cand = 0, free_flagged = 0;
+    for (size_t i = 0; i < f->nfluid; i++) {
+        double x = f->x[i][0], y = f->x[i][1];
+        if (x > w - 4 * dp || y > h - 4 * dp) /* the free faces: candidates anyway */
+            continue;
+        int cand = f->nd[i] < nlim && f->ncount[i] < clim && f->nd[i] < nmin;
+        if (x < 1.5 * dp || y < 1.5 * dp) { /* wall particles within re_n */
+            wall_cand += cand;
+            wall_flagged += cand && f->surface[i];
+        } else if (x > 4 * dp && y > 4 * dp) { /* none within re_n */
+            free_cand += cand;
+            free_flagged += cand && f->surface[i];
+        }
+    }
+    printf("surface scan, column stretched 10%%: next to the walls %zu of %zu sparse candidates "
+           "on the surface, away from them %zu of %zu\n", wall_flagged, wall_cand, free_flagged,
+           free_cand);
+    CHECK(wall_cand > 20 && free_cand > 100); /* the setting makes both kinds */
+    CHECK(wall_flagged == 0);                 /* scanned: they keep their rows */
+    CHECK(free_flagged == free_cand);         /* not scanned: spray stays on the surface */
+    fluid_destroy(&f);
+}
+
 static void test_verlet_list(void)
 {
     const char *sets[] = {"dp=0.008"};
@@ -1392,6 +1438,7 @@ int main(int argc, char **argv)
     test_divergence_slip();
     test_verlet_list();
     test_surface_double_check();
+    test_surface_scan_walls();
     test_body_shadow();
     test_divergence_near_bodies();
     test_tank_corners();
