@@ -95,6 +95,11 @@ def run_list():
                                          None)
         r[f'{case}_1_tlsph_implicit'] = (case, ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
                                                 'output.interval=0.1'], TLSPH)
+    # the measured roll at 1 mm with the case's setting (twenty-ninth session),
+    # against high_1_mps_implicit over the cycles both hold
+    r['high_1_mps_implicit_table'] = ('high', ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
+                                               'output.interval=0.1', 'motion.kind=table',
+                                               'end_time=4.98'], None)
     return r
 
 

@@ -37,6 +37,8 @@ int mps_utf8_valid(const char *s)
 
 const char *mps_utf8_escaped(const char *s, char *buf, size_t n)
 {
+    if (n == 0)
+        return buf;
     size_t at = 0;
     for (const unsigned char *p = (const unsigned char *)s; *p && at + 5 < n;) {
         size_t k = mps_utf8_seq(p);
