@@ -6,7 +6,6 @@
 #include <time.h>
 #include <unistd.h>
 
-#include "mps_case.h"
 #include "mps_host.h"
 #include "mps_utf8.h"
 #include "mps_version.h"
