@@ -508,20 +508,28 @@ def placement_while_running(extra):
     return seen, stop_long_run(p, out)
 
 
-def unclaimed_cpus(allowed):
-    """The CPUs no coupler on the machine holds now (each lock file taken
-    and given back at once, as launch.c takes them)."""
+def take_cpu_locks(allowed):
+    """Takes the lock file of every allowed CPU no coupler holds, as
+    launch.c takes them: (the open descriptors, the CPUs taken). Closing
+    the descriptors gives them back."""
     import fcntl
-    free = set()
+    held, taken = [], set()
     for cpu in sorted(allowed):
         fd = os.open(f'/tmp/mpsfsi-cpu{cpu}.lock', os.O_RDONLY | os.O_CREAT, 0o644)
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            free.add(cpu)
+            taken.add(cpu)
         except OSError:
-            pass
-        finally:
-            os.close(fd)
+            pass  # another coupler holds it
+        held.append(fd)
+    return held, taken
+
+
+def unclaimed_cpus(allowed):
+    """The CPUs no coupler on the machine holds now."""
+    held, free = take_cpu_locks(allowed)
+    for fd in held:
+        os.close(fd)
     return free
 
 
@@ -580,16 +588,7 @@ def t_cpu_placement_auto(allowed):
 
 def t_cpu_placement_all_claimed(allowed):
     """Every CPU claimed (its lock file held here): the run is not pinned."""
-    import fcntl
-    held, mine = [], set()
-    for cpu in sorted(allowed):
-        fd = os.open(f'/tmp/mpsfsi-cpu{cpu}.lock', os.O_RDONLY | os.O_CREAT, 0o644)
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            mine.add(cpu)
-        except OSError:
-            pass  # another test's coupler holds it
-        held.append(fd)
+    held, mine = take_cpu_locks(allowed)
     seen, note = placement_while_running([])
     for fd in held:
         os.close(fd)

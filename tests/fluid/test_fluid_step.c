@@ -558,6 +558,22 @@ static void test_surface_closure(void)
     CHECK(worst_of[1] >= 1e-2); /* the check sees a missing term */
 }
 
+/* The dam-break column at dp = 1 cm (the case's 0.146 x 0.292 m) stretched
+ * by s from the corner and stepped once by 1e-5 s, so the free-surface
+ * tests see the double check and the scan on a known spacing. */
+static struct fluid *stretched_column(const char **sets, int nsets, double s)
+{
+    struct fluid *f = make("cases/dambreak/case.yml", sets, nsets);
+    CHECK(f != NULL);
+    if (!f)
+        return NULL;
+    for (size_t i = 0; i < f->nfluid; i++)
+        for (int d = 0; d < MPS_DIM; d++)
+            f->x[i][d] *= s;
+    CHECK(step(f, 1e-5) == MPS_OK);
+    return f;
+}
+
 /* The free-surface double check (paper 4.3): a particle is on the surface
  * only if its number density is below beta1 n0 AND its neighbour count is
  * below beta2 N0. The dam-break column at dp = 1 cm, stretched by 3% from
@@ -572,15 +588,10 @@ static void test_surface_closure(void)
 static void test_surface_double_check(void)
 {
     const char *sets[] = {"dp=0.01", "fluid.surface_scan=0"};
-    struct fluid *f = make("cases/dambreak/case.yml", sets, 2);
-    CHECK(f != NULL);
+    const double s = 1.03, dp = 0.01, w = s * 0.146, h = s * 0.292;
+    struct fluid *f = stretched_column(sets, 2, s);
     if (!f)
         return;
-    const double s = 1.03, dp = 0.01, w = s * 0.146, h = s * 0.292;
-    for (size_t i = 0; i < f->nfluid; i++)
-        for (int d = 0; d < MPS_DIM; d++)
-            f->x[i][d] *= s;
-    CHECK(step(f, 1e-5) == MPS_OK);
     const double nlim = f->prm.beta1 * f->n0;
     size_t inner = 0, thin = 0, flagged = 0, top = 0, top_flagged = 0;
     for (size_t i = 0; i < f->nfluid; i++) {
@@ -615,15 +626,10 @@ static void test_surface_double_check(void)
 static void test_surface_scan_walls(void)
 {
     const char *sets[] = {"dp=0.01"};
-    struct fluid *f = make("cases/dambreak/case.yml", sets, 1);
-    CHECK(f != NULL);
+    const double s = 1.1, dp = 0.01, w = s * 0.146, h = s * 0.292;
+    struct fluid *f = stretched_column(sets, 1, s);
     if (!f)
         return;
-    const double s = 1.1, dp = 0.01, w = s * 0.146, h = s * 0.292;
-    for (size_t i = 0; i < f->nfluid; i++)
-        for (int d = 0; d < MPS_DIM; d++)
-            f->x[i][d] *= s;
-    CHECK(step(f, 1e-5) == MPS_OK);
     const double nlim = f->prm.beta1 * f->n0, clim = f->prm.beta2 * f->count0;
     const double nmin = f->prm.surface_scan_density * f->n0;
     size_t wall_cand = 0, wall_flagged = 0, free_cand = 0, free_flagged = 0;
