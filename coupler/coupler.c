@@ -110,6 +110,8 @@ struct coupler {
     struct coupling_iter iter;
     struct coupling_accel *accel;
     int max_iter, on_max_error;
+    int predict_solid;         /* coupling.implicit.predictor: solid */
+    long predictions;          /* the solid's solves alone, as predictors */
     long iterations;           /* fluid and solid solve pairs, all steps */
     int iter_max;              /* most in one step */
     long limit_hits;           /* steps accepted at max_iterations */
@@ -624,6 +626,32 @@ static void count_iterations(struct coupler *c, int k)
     c->iter_hist[b]++;
 }
 
+/* The first iterate from the solid alone (coupling.implicit.predictor:
+ * solid): it takes the step under the last step's loads, which c->loads
+ * still holds, as iteration 0 of its own; the iterations with the fluid
+ * then repeat the step from its start as the solid's iterations 1, 2, ...
+ * (PROTOCOL.md 6: each solver numbers the iterations it is sent). Before
+ * the first step there are no loads, and that step extrapolates. */
+static enum mps_status solid_prediction(struct coupler *c, struct proto_msg *adv, int n_sub,
+                                        struct proto_msg *send, int *ahead, struct mps_err *err)
+{
+    *ahead = 0;
+    if (!c->predict_solid || c->loads.payload != PROTO_LOADS)
+        return MPS_OK;
+    adv->iteration = 0;
+    struct proto_msg sadv = solid_advance(c, adv, n_sub), res = {0};
+    enum mps_status st = exchange(c, SOLID, &sadv, &res, err);
+    if (!st)
+        st = coupling_iter_predicted(&c->iter, &res, send, err);
+    proto_msg_clear(&res);
+    if (st)
+        return mps_err_prefix(err, "step %ld at t = %.6g s, the solid's prediction: ", c->step,
+                              c->time);
+    c->predictions++;
+    *ahead = 1;
+    return MPS_OK;
+}
+
 /* One step of implicit coupling (coupling_iter.h): the fluid and the solid
  * repeat the step from its start, the coupler choosing the solid state the
  * fluid sees, until the solid's answer agrees with it. The solid's last
@@ -640,6 +668,9 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
     if (!st)
         st = coupling_accel_begin(c->accel, coupling_iter_len(&c->iter), err);
     c->accel_seconds += mps_wall_seconds() - a0;
+    int ahead = 0; /* the solid's iteration numbers lead the fluid's by this */
+    if (!st)
+        st = solid_prediction(c, adv, n_sub, &send, &ahead, err);
     if (st)
         return st;
     int k = 0, converged = 0, rerun = 0;
@@ -658,6 +689,7 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
         proto_msg_clear(&c->loads);
         c->loads = res;
         struct proto_msg sadv = solid_advance(c, adv, n_sub);
+        sadv.iteration = k + ahead;
         res = (struct proto_msg){0};
         if ((st = exchange(c, SOLID, &sadv, &res, err)))
             return st;
@@ -726,7 +758,7 @@ struct coupler_scalars {
  * column coupling_iterations (a mean since the last row, which a checkpoint
  * may fall inside). */
 struct implicit_counters {
-    int64_t iterations, iter_max, limit_hits, hist[8], probe_sum, probe_steps;
+    int64_t iterations, iter_max, limit_hits, hist[8], probe_sum, probe_steps, predictions;
     double change_max;
 };
 _Static_assert(sizeof ((struct coupler *)0)->iter_hist == 8 * sizeof(long), "histogram bins");
@@ -734,9 +766,67 @@ _Static_assert(sizeof ((struct coupler *)0)->iter_hist == 8 * sizeof(long), "his
 /* Implicit coupling's history, after the coupler's scalars: the counters,
  * the interface iteration's (coupling_iter_put: the displacement reference,
  * the predictor) and the acceleration's (coupling_accel_put: Aitken's
- * factor, IQN-ILS's reused columns). Without it the next steps would start
- * from another predictor and factor or without the columns: the same
- * physics within the tolerance, not the same bits. */
+ * factor, IQN-ILS's reused columns), and with the solid predictor the last
+ * step's loads ("implicit.loads": the fluid sends them again only after the
+ * next step's first solve). Without it the next steps would start from
+ * another predictor and factor or without the columns: the same physics
+ * within the tolerance, not the same bits. */
+static enum mps_status put_loads(const struct proto_msg *l, struct mps_ckpt *ck,
+                                 struct mps_err *err)
+{
+    int64_t count = l->payload == PROTO_LOADS ? (int64_t)l->count : -1;
+    size_t n = count > 0 ? (size_t)count : 0;
+    enum mps_status st;
+    if ((st = mps_ckpt_put(ck, "implicit.loads", &count, sizeof count, err)) || !n)
+        return st;
+    if ((st = mps_ckpt_put(ck, "implicit.loads.id", l->id, n * sizeof *l->id, err)) ||
+        (st = mps_ckpt_put(ck, "implicit.loads.pressure", l->pressure, n * sizeof *l->pressure,
+                           err)))
+        return st;
+    return mps_ckpt_put(ck, "implicit.loads.force", l->force, n * sizeof *l->force, err);
+}
+
+/* The loads put_loads saved, into l (which then owns their storage). */
+static enum mps_status get_loads(struct mps_ckpt *ck, struct proto_msg *l, struct mps_err *err)
+{
+    int64_t count;
+    enum mps_status st = mps_ckpt_get(ck, "implicit.loads", &count, sizeof count, err);
+    if (st || count < 0)
+        return st;
+    const size_t n = (size_t)count;
+    const void *id, *pr, *fo;
+    size_t bi, bp, bf;
+    if (n && ((st = mps_ckpt_get_any(ck, "implicit.loads.id", &id, &bi, err)) ||
+              (st = mps_ckpt_get_any(ck, "implicit.loads.pressure", &pr, &bp, err)) ||
+              (st = mps_ckpt_get_any(ck, "implicit.loads.force", &fo, &bf, err))))
+        return st;
+    const size_t want_i = n * sizeof(int), want_p = n * sizeof(double),
+                 want_f = n * sizeof(double[MPS_DIM]);
+    if (n && (bi != want_i || bp != want_p || bf != want_f))
+        return mps_err_set(err, MPS_EINPUT,
+                           "the last step's loads hold %zu / %zu / %zu bytes of ids, pressures "
+                           "and forces for %zu particles",
+                           bi, bp, bf, n);
+    unsigned char *own = malloc(want_f + want_p + want_i + 1);
+    if (!own)
+        return mps_err_set(err, MPS_ENOMEM, "out of memory for the last step's loads");
+    proto_msg_clear(l);
+    *l = proto_msg_make(PROTO_RESULT);
+    l->payload = PROTO_LOADS;
+    l->count = n;
+    l->own_ = own;
+    if (n) { /* the doubles first: the block from malloc is aligned for them */
+        memcpy(own, fo, want_f);
+        memcpy(own + want_f, pr, want_p);
+        memcpy(own + want_f + want_p, id, want_i);
+        l->force = (const double(*)[MPS_DIM])own;
+        l->pressure = (const double *)(own + want_f);
+        l->id = (const int *)(own + want_f + want_p);
+    }
+    return MPS_OK;
+}
+
+
 static enum mps_status put_implicit(const struct coupler *c, struct mps_ckpt *ck,
                                     struct mps_err *err)
 {
@@ -750,11 +840,13 @@ static enum mps_status put_implicit(const struct coupler *c, struct mps_ckpt *ck
     ic.probe_sum = c->iter_probe_sum;
     ic.probe_steps = c->iter_probe_steps;
     ic.change_max = c->change_max;
+    ic.predictions = c->predictions;
     enum mps_status st;
     if ((st = mps_ckpt_put(ck, "implicit", &ic, sizeof ic, err)) ||
-        (st = coupling_iter_put(&c->iter, ck, err)))
+        (st = coupling_iter_put(&c->iter, ck, err)) ||
+        (st = coupling_accel_put(c->accel, ck, err)))
         return st;
-    return coupling_accel_put(c->accel, ck, err);
+    return c->predict_solid ? put_loads(&c->loads, ck, err) : MPS_OK;
 }
 
 static enum mps_status get_implicit(struct coupler *c, struct mps_err *err)
@@ -765,6 +857,8 @@ static enum mps_status get_implicit(struct coupler *c, struct mps_err *err)
         (st = coupling_iter_get(&c->iter, &c->disk, err)) ||
         (st = coupling_accel_get(c->accel, &c->disk, err)))
         return mps_err_prefix(err, "%s: ", c->restart_path);
+    if (c->predict_solid && (st = get_loads(&c->disk, &c->loads, err)))
+        return mps_err_prefix(err, "%s: ", c->restart_path);
     c->iterations = (long)ic.iterations;
     c->iter_max = (int)ic.iter_max;
     c->limit_hits = (long)ic.limit_hits;
@@ -773,6 +867,7 @@ static enum mps_status get_implicit(struct coupler *c, struct mps_err *err)
     c->iter_probe_sum = (long)ic.probe_sum;
     c->iter_probe_steps = (long)ic.probe_steps;
     c->change_max = ic.change_max;
+    c->predictions = (long)ic.predictions;
     return MPS_OK;
 }
 
@@ -1079,6 +1174,8 @@ static void write_summary_json(struct coupler *c, enum mps_status st, const stru
     mps_json_str(&j, "scheme", c->implicit ? "implicit" : "explicit");
     if (c->implicit) {
         mps_json_str(&j, "acceleration", c->accel ? coupling_accel_name(c->accel) : "");
+        mps_json_str(&j, "predictor", c->predict_solid ? "solid" : "extrapolate");
+        mps_json_int(&j, "solid_predictions", c->predictions);
         mps_json_int(&j, "steps", c->step);
         mps_json_int(&j, "total", c->iterations);
         mps_json_num(&j, "mean", c->step ? (double)c->iterations / c->step : 0.0);
@@ -1273,6 +1370,8 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
     c->implicit = strcmp(mps_case_string(c->cs, "coupling.scheme"), "implicit") == 0;
     c->max_iter = (int)mps_case_int(c->cs, "coupling.implicit.max_iterations");
     c->on_max_error = strcmp(mps_case_string(c->cs, "coupling.implicit.on_max"), "error") == 0;
+    c->predict_solid =
+        strcmp(mps_case_string(c->cs, "coupling.implicit.predictor"), "solid") == 0;
     const char *ext = opt[OPT_EXTERNAL].value;
     if (ext && strcmp(ext, "fluid") && strcmp(ext, "solid"))
         return mps_err_set(err, MPS_EINPUT, "--external %s: must be fluid or solid", ext);
@@ -1309,6 +1408,15 @@ static enum mps_status load_case(struct coupler *c, const struct mps_cli *cli,
                            "%s: holds no history of the implicit coupling (section 'implicit': "
                            "written by a build that did not checkpoint implicit runs); it cannot "
                            "continue this implicit run bit for bit: run it again from the start",
+                           c->restart_path);
+    /* and the solid predictor's last loads (get_loads) one of its own */
+    if (c->implicit && c->restart && c->predict_solid &&
+        !mps_ckpt_has(&c->disk, "implicit.loads"))
+        return mps_err_set(err, MPS_EINPUT,
+                           "%s: holds no loads of the last step for the solid predictor "
+                           "(section 'implicit.loads': written by a build before "
+                           "coupling.implicit.predictor); it cannot continue this run bit for "
+                           "bit: run it again from the start",
                            c->restart_path);
     return MPS_OK;
 }

@@ -128,6 +128,20 @@ enum mps_status coupling_iter_start(struct coupling_iter *it, const struct proto
     return MPS_OK;
 }
 
+enum mps_status coupling_iter_predicted(struct coupling_iter *it, const struct proto_msg *pred,
+                                        struct proto_msg *send, struct mps_err *err)
+{
+    enum mps_status st = same_interface(it, pred, err);
+    if (st)
+        return st;
+    for (size_t k = 0; k < it->n; k++)
+        if (!it->fixed[k])
+            for (int a = 0; a < MPS_DIM; a++)
+                it->in[MPS_DIM * k + a] = pred->x[k][a];
+    unpack(it, it->in, send);
+    return MPS_OK;
+}
+
 enum mps_status coupling_iter_result(struct coupling_iter *it, const struct proto_msg *res,
                                      int *converged, struct mps_err *err)
 {

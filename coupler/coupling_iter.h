@@ -27,7 +27,13 @@
  * the last two steps' starts, x_n + (x_n - x_(n-1)) dt_n / dt_(n-1) (the
  * first step: x_0 + v_0 dt). It saves iterations: on the standard plate
  * (6 mm, to 1 s) 1.16 per step against 1.48 starting from the solid's state
- * at the step's start. */
+ * at the step's start. Or, with coupling.implicit.predictor: solid (the
+ * default), the positions the solid reaches over the step under the last
+ * step's loads (coupling_iter_predicted): the extrapolation carries the
+ * error the last step was accepted with and misses the solid's own
+ * acceleration; the solid's prediction misses only the change of the loads.
+ * On the 6 mm plate 1.02 fluid advances per step against 1.32, on the light
+ * plate 3.42 against 4.17 (docs/coupling.md). */
 #ifndef COUPLING_ITER_H
 #define COUPLING_ITER_H
 
@@ -68,6 +74,12 @@ void coupling_iter_free(struct coupling_iter *it);
  * send (a STATE message whose arrays live in it) with the first input. */
 enum mps_status coupling_iter_start(struct coupling_iter *it, const struct proto_msg *now,
                                     double dt, struct proto_msg *send, struct mps_err *err);
+
+/* After coupling_iter_start, the first input replaced by the interface of
+ * pred, a STATE of the solid advanced alone over the step (the same
+ * interface as READY's, clamped particles kept where they are). */
+enum mps_status coupling_iter_predicted(struct coupling_iter *it, const struct proto_msg *pred,
+                                        struct proto_msg *send, struct mps_err *err);
 
 /* The solid's RESULT of the iteration: checks that it is the same interface
  * (ids in READY's order: a solid whose interface changes size within an

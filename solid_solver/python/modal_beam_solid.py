@@ -323,6 +323,9 @@ def converse(sock, courant, t_wall):
         if m.type != mp.Type.ADVANCE:
             raise Fail('protocol', f'expected ADVANCE, STOP or ABORT, got {mp.Type(m.type).name}')
         c0 = time.time()
+        # iteration 0 starts a step (kept), a later one repeats it from there; the
+        # coupler's solid prediction (PROTOCOL.md 6) is such an iteration 0 under
+        # the last step's loads, so nothing here needs to know about it
         if roll.check(m) == 'new':
             kept = (beam.q, beam.qd, len(snaps.grids))
         else:

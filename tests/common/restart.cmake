@@ -87,6 +87,11 @@ set_tests_properties(restart_coupled_python_solid PROPERTIES TIMEOUT 120 LABELS 
 # the checkpoint at 0.1 s falls inside a probe interval (the load integral
 # and the mean iterations of the row are carried over). Each fails with that part
 # of the history not restored (docs/restart.md, "Proof"). 2-3 s per run here.
+# Aitken runs the default solid predictor (the last step's loads come back from
+# the checkpoint), IQN-ILS the extrapolating one (the last step's start and
+# length come back), so each predictor's part of the history is proven.
+set(predictor_aitken solid)
+set(predictor_iqn_ils extrapolate)
 foreach(accel aitken iqn_ils)
   add_test(NAME restart_coupled_plate_implicit_${accel}
     COMMAND ${RS_CHECK} ${RS_OUT}/plate_implicit_${accel} 0.1 0.15 $<TARGET_FILE:coupler>
@@ -94,6 +99,7 @@ foreach(accel aitken iqn_ils)
             --set output.interval=0.05 --set output.checkpoint_interval=0.05
             --set coupling.scheme=implicit --set coupling.implicit.acceleration=${accel}
             --set coupling.implicit.reuse=8 --set coupling.implicit.log=true
+            --set coupling.implicit.predictor=${predictor_${accel}}
             --set output.probe_interval=0.003
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 endforeach()
@@ -101,7 +107,9 @@ endforeach()
 # checkpoint rewritten by each iteration of the step, PROTOCOL.md 6): at the
 # tolerance 0.01 the checkpoint step ending at 0.05 s takes two iterations
 # (at the default 0.1 every checkpoint step takes one, and a solid numbering
-# each iteration's checkpoint as a new one passes: checked)
+# each iteration's checkpoint as a new one passes: checked with the
+# extrapolating predictor; the solid predictor sends the solid two ADVANCEs
+# in every step, its prediction and the first iteration)
 add_test(NAME restart_coupled_python_solid_implicit
   COMMAND ${RS_CHECK} ${RS_OUT}/python_implicit 0.1 0.15 $<TARGET_FILE:coupler>
           tests/coupler/plate_in_water.yml --set end_time=0.2 --set output.interval=0.05
@@ -119,6 +127,14 @@ add_test(NAME restart_bad_implicit_no_history
           $<TARGET_FILE:coupler> ${RS_OUT}/implicit_old
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(restart_bad_implicit_no_history PROPERTIES TIMEOUT 60 LABELS integration)
+# the same without the last step's loads, which the solid predictor (the
+# default coupling.implicit.predictor) starts the next step from: cut after
+# the acceleration's last block, as builds before the predictor wrote it
+add_test(NAME restart_bad_implicit_no_loads
+  COMMAND sh -c "rm -rf \"$1\" && \"$0\" tests/coupler/plate_in_water.yml --out \"$1\" --quiet --set end_time=0.1 --set output.interval=0 --set coupling.scheme=implicit --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$1\"/checkpoint/coupler_000001.ckpt accel.W && sh tests/expect_fail.sh 'coupler_000001.ckpt: holds no loads of the last step for the solid predictor' \"$0\" --restart \"$1\""
+          $<TARGET_FILE:coupler> ${RS_OUT}/implicit_no_loads
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_bad_implicit_no_loads PROPERTIES TIMEOUT 60 LABELS integration)
 
 mps_add_test(test_ckpt SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ckpt.c LABELS unit TIMEOUT 30)
 

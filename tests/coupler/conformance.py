@@ -33,8 +33,11 @@ the coupler launches solvers (`COMMAND --connect ENDPOINT`, coupler/launch.c):
   rollback        only for a solid that declares caps=rollback in HELLO: CONFIG with
                   rollback=on, then step 0 with loads A, repeated with loads B, repeated
                   with loads A (must give iteration 0's RESULT bit for bit: the state of the
-                  step's start was restored), step 1 with A twice (the same), then an
-                  iteration out of order: ERROR "protocol: ...", exit 1
+                  step's start was restored), step 1 with A twice (the same), step 2 as
+                  the coupler's solid prediction runs it (iteration 0 with the last
+                  step's loads A, then B twice, with SNAPSHOT and PROBES: the two B
+                  iterations bit for bit), then an iteration out of order: ERROR
+                  "protocol: ...", exit 1
   checkpoint      only for a solid that declares caps=checkpoint: step 0 (loads A), step 1
                   (loads A, CHECKPOINT), step 2 (loads B, PROBES), STOP; then a second
                   process with CONFIG restart=1 in the same out directory: its READY must
@@ -965,8 +968,18 @@ class Suite:
         self.check('rollback.repeat_next_step', not d,
                    'step 1 (from the accepted iteration 2 of step 0) repeated with the same loads: '
                    'bit for bit' if not d else f'differs in {", ".join(d)}')
-        s.send(mp.Message(mp.Type.ADVANCE, payload=mp.Payload.NONE, step=1, iteration=3,
-                          time=dt, dt=dt, n_sub=n))
+        # the coupler's solid prediction (section 6, coupling.implicit.predictor:
+        # solid): the solid alone under the last step's loads as iteration 0, then
+        # the fluid's loads as iterations 1, 2, ..., every one with the step's flags
+        fs = fl | mp.F_SNAPSHOT
+        p0, p1, p2 = result(2, 0, a, fs), result(2, 1, b, fs), result(2, 2, b, fs)
+        d = same(p1, p2)
+        self.check('rollback.prediction', not d and bool(same(p0, p1)),
+                   'step 2 predicted under loads A, then B twice: the two B iterations bit for '
+                   'bit' if not d else f'the B iterations after the prediction differ in '
+                   f'{", ".join(d)}: the prediction\'s step was not undone')
+        s.send(mp.Message(mp.Type.ADVANCE, payload=mp.Payload.NONE, step=2, iteration=4,
+                          time=2 * dt, dt=dt, n_sub=n))
         self.expect_error(s, 'rollback.out_of_order', 'protocol', 1)
 
     def scenario_checkpoint(self, s):

@@ -5,7 +5,7 @@ summary.json and probes.csv.
 usage: hard_check.py RUN_DIR --end T [--tip-bound B] [--max-iterations-mean N]
                      [--static LO HI T0 T1] [--drift D T0 T1 T2 T3] [--expect-unstable]
                      [--rigid RIGID_RUN EI LO HI] [--compare OTHER_RUN RMS]
-                     [--still-load H1 H2 DP TOL T0 T1]
+                     [--still-load H1 H2 DP TOL T0 T1] [--fewer-iterations OTHER_RUN F]
 
 Stable: the coupler ended normally at time T and |tip_dx| stayed below B (m).
 --max-iterations-mean: the implicit coupling's mean iterations per step.
@@ -17,6 +17,8 @@ whose probe tip_EI is that tip times E I; EI in N m) lies in [LO, HI], both
 as running means over 10 ms.
 --compare OTHER_RUN RMS: the RMS difference of tip_dx from OTHER_RUN's over
 [0, T] is at most RMS (m).
+--fewer-iterations OTHER_RUN F: the mean fluid advances per coupling step are
+at most F times OTHER_RUN's (both implicit).
 --still-load H1 H2 DP TOL T0 T1: the means of the probes load_fx and
 load_moment (about the plate's foot) over [T0, T1] within TOL (a fraction)
 of the still water's rho g (h1^2 - h2^2) / 2 and -rho g (h1^3 - h2^3) / 6,
@@ -55,6 +57,7 @@ def main():
     ap.add_argument('--expect-unstable', action='store_true')
     ap.add_argument('--rigid', nargs=4)
     ap.add_argument('--compare', nargs=2)
+    ap.add_argument('--fewer-iterations', nargs=2)
     ap.add_argument('--still-load', nargs=6, type=float)
     a = ap.parse_args()
     s = json.load(open(os.path.join(a.run, 'summary.json')))
@@ -83,6 +86,16 @@ def main():
               f'{a.max_iterations_mean}), max {it.get("max")}, limit hits {it.get("limit_hits")}')
         if not ok:
             fails.append('iterations')
+    if a.fewer_iterations:
+        with open(os.path.join(a.fewer_iterations[0], 'summary.json')) as f:
+            other = json.load(f).get('iterations', {})
+        m, mo, fac = it.get('mean', 0.0), other.get('mean', 0.0), float(a.fewer_iterations[1])
+        ok = (it.get('scheme') == 'implicit' and other.get('scheme') == 'implicit' and mo > 0
+              and m <= fac * mo)
+        print(('ok    ' if ok else 'FAIL  ') + f'iterations per step: mean {m:.3f} ({it.get("predictor")} '
+              f'predictor) against {mo:.3f} ({other.get("predictor")}), at most {fac} times it')
+        if not ok:
+            fails.append('fewer iterations')
 
     def mean(t0, t1):
         m = (t >= t0) & (t <= t1)

@@ -1,5 +1,6 @@
 /* The implicit coupling's interface vector (coupler/coupling_iter.h): what
- * the fluid is sent (positions and the step's mean velocity), the predictor,
+ * the fluid is sent (positions and the step's mean velocity), the predictors
+ * (extrapolated, or the solid's own),
  * the convergence test on the step's displacement, clamped particles, the
  * best iterate, and the refusal of an interface that changes. */
 #include <math.h>
@@ -82,6 +83,30 @@ int main(void)
     /* its answer again: now the last is the best, nothing to repeat */
     CHECK(coupling_iter_result(&it, &r2, &conv, &err) == MPS_OK);
     CHECK(coupling_iter_best(&it, &send) == 0);
+
+    /* the solid's prediction replaces the first input: its positions, the
+     * mean velocity from the step's start, the clamped particle where it
+     * was (the prediction moves it: ignored); the x_prev the next
+     * extrapolation would use stays the step's start */
+    double xp[N][2] = {{0.013, 0.001}, {0.012, 1}, {0.5, -1}};
+    struct proto_msg pred = state(xp, v1);
+    CHECK(coupling_iter_start(&it, &r2, dt, &send, &err) == MPS_OK);
+    CHECK(coupling_iter_predicted(&it, &pred, &send, &err) == MPS_OK);
+    CHECK(send.x[0][0] == 0.013 && send.x[0][1] == 0.001 && send.x[1][0] == 0.012);
+    CHECK_NEAR(send.v[0][0], (0.013 - 0.016) / dt, 1e-12);
+    CHECK_NEAR(send.v[0][1], 0.001 / dt, 1e-12);
+    CHECK(send.x[2][0] == 0.0 && send.v[2][0] == 0.0);
+    CHECK(it.x_prev[0][0] == 0.016);
+    /* the answer equal to the prediction converges */
+    struct proto_msg rp = state(xp, v1);
+    double xq[N][2] = {{0.013, 0.001}, {0.012, 1}, {0, -1}};
+    rp.x = (const double(*)[2])xq;
+    CHECK(coupling_iter_result(&it, &rp, &conv, &err) == MPS_OK && conv && it.change == 0.0);
+    /* a prediction of another interface is refused */
+    int swapped[N] = {7, 4, 9};
+    pred.id = swapped;
+    CHECK(coupling_iter_predicted(&it, &pred, &send, &err) == MPS_EINPUT);
+    CHECK(strstr(err.msg, "id 7") != NULL);
 
     /* absolute tolerance, for an interface at rest: a velocity error of
      * 0.5e-4 m/s converges at 1e-4 m/s, 2e-4 m/s does not */
