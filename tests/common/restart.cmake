@@ -127,6 +127,15 @@ add_test(NAME restart_bad_implicit_no_history
           $<TARGET_FILE:coupler> ${RS_OUT}/implicit_old
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(restart_bad_implicit_no_history PROPERTIES TIMEOUT 60 LABELS integration)
+# a solver's checkpoint damaged (one bit of solid_000001.ckpt flipped): the
+# solid answers ERROR "input: ...", and the coupler must keep that status
+# (exit 2, its line "coupler: input: solid solver: input: ..."), as for any
+# input error of a solver that is not one of its case keys
+add_test(NAME restart_bad_solver_checkpoint_damaged
+  COMMAND sh -c "rm -rf \"$1\" && \"$0\" tests/coupler/plate_in_water.yml --out \"$1\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 -c \"import sys; p = sys.argv[1]; b = bytearray(open(p, 'rb').read()); b[200] ^= 1; open(p, 'wb').write(b)\" \"$1\"/checkpoint/solid_000001.ckpt && { \"$0\" --restart \"$1\" 2>\"$1.err\"; rc=$?; test $rc -eq 2 && grep -q '^coupler: input: solid solver: input: .*solid_000001.ckpt: checkpoint damaged' \"$1.err\"; }"
+          $<TARGET_FILE:coupler> ${RS_OUT}/solver_damaged
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_bad_solver_checkpoint_damaged PROPERTIES TIMEOUT 60 LABELS integration)
 # the same without the last step's loads, which the solid predictor (the
 # default coupling.implicit.predictor) starts the next step from: cut after
 # the acceleration's last block, as builds before the predictor wrote it

@@ -544,7 +544,7 @@ FAULTS = [
       old='st = mps_err_set(err, es == MPS_EINPUT ? MPS_EINPUT : (es ? es : MPS_EPEER),',
       new='st = mps_err_set(err, MPS_EPEER,',
       what="a solver's ERROR loses its status (an input error no longer exits 2)",
-      hint='coupler_fluid_fails|broken_case_files'),
+      hint='coupler_fluid_fails|broken_case_files|restart_bad_solver_checkpoint_damaged'),
     # ---- the solvers own their keys (issue 22, PROTOCOL.md 8: case errors) ----
     F(id='case_error_unmarked', eq='PROTOCOL.md 8: case error', file='solid_solver/solid_peer.c',
       old='        return proto_solver_case_error(st, err);',
