@@ -940,10 +940,10 @@ def main():
              'is the 1-minute load average when the run started (2 CPUs), so compare times only '
              'within a table and at similar load, and re-time with the commands given.', '',
              'The implicit rows below were measured before 2026-12-05, when the first iterate '
-             'of a step was the extrapolated interface; since then the default is the solid\'s '
-             'own prediction (`coupling.implicit.predictor: solid`), which takes fewer '
-             'iterations: on the standard plate at 6 mm 1.02 fluid advances per step against '
-             '1.32 to 2 s, on the light plate at 3 mm 3.42 against 4.17 to 1 s '
+             'of a step was the extrapolated interface; since then the default blends in the '
+             'solid\'s own prediction (`coupling.implicit.predictor: solid`), which takes fewer '
+             'iterations: on the standard plate at 6 mm 1.03 fluid advances per step against '
+             '1.32 to 2 s, on the light plate at 3 mm 3.16 against 4.17 to 1 s '
              '(docs/coupling.md, "Predictor"). `--set coupling.implicit.predictor=extrapolate` '
              'on a row\'s command gives the setting it was measured with.', '']
     if A.quick:

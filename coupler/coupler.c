@@ -716,6 +716,7 @@ static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
             rerun = 2; /* the repeat of the best is sent now; accepted whatever it gives */
     }
     coupling_accel_end(c->accel);
+    coupling_iter_accept(&c->iter);
     count_iterations(c, k);
     double rel = c->iter.increment > 0.0 ? c->iter.change / c->iter.increment : 0.0;
     if (!converged) {
@@ -1176,6 +1177,8 @@ static void write_summary_json(struct coupler *c, enum mps_status st, const stru
         mps_json_str(&j, "acceleration", c->accel ? coupling_accel_name(c->accel) : "");
         mps_json_str(&j, "predictor", c->predict_solid ? "solid" : "extrapolate");
         mps_json_int(&j, "solid_predictions", c->predictions);
+        if (c->predict_solid) /* the prediction's weight at the end (coupling_iter.h) */
+            mps_json_num(&j, "prediction_weight", c->iter.w);
         mps_json_int(&j, "steps", c->step);
         mps_json_int(&j, "total", c->iterations);
         mps_json_num(&j, "mean", c->step ? (double)c->iterations / c->step : 0.0);

@@ -29,13 +29,17 @@ enum mps_status coupling_iter_init(struct coupling_iter *it, const struct proto_
     it->out = malloc(m * sizeof *it->out * MPS_DIM);
     it->next = malloc(m * sizeof *it->next * MPS_DIM);
     it->best = malloc(m * sizeof *it->best * MPS_DIM);
+    it->pred_e = malloc(m * sizeof *it->pred_e * MPS_DIM);
+    it->pred_p = malloc(m * sizeof *it->pred_p * MPS_DIM);
     if (!it->id || !it->surface || !it->fixed || !it->x0 || !it->x_start || !it->x_prev ||
-        !it->x_send || !it->v_send || !it->in || !it->out || !it->next || !it->best) {
+        !it->x_send || !it->v_send || !it->in || !it->out || !it->next || !it->best ||
+        !it->pred_e || !it->pred_p) {
         coupling_iter_free(it);
         return mps_err_set(err, MPS_ENOMEM, "implicit coupling: out of memory for %zu particles",
                            n);
     }
     it->n = n;
+    it->w = 1.0;
     if (n) {
         memcpy(it->id, ready->id, n * sizeof *it->id);
         memcpy(it->surface, ready->surface, n);
@@ -59,6 +63,8 @@ void coupling_iter_free(struct coupling_iter *it)
     free(it->out);
     free(it->next);
     free(it->best);
+    free(it->pred_e);
+    free(it->pred_p);
     memset(it, 0, sizeof *it);
 }
 
@@ -122,6 +128,7 @@ enum mps_status coupling_iter_start(struct coupling_iter *it, const struct proto
         }
     memcpy(it->x_prev, now->x, it->n * sizeof *it->x_prev);
     it->dt_prev = dt;
+    it->have_pred = 0;
     it->best_change = INFINITY;
     it->best_k = it->last_k = -1;
     unpack(it, it->in, send);
@@ -134,12 +141,36 @@ enum mps_status coupling_iter_predicted(struct coupling_iter *it, const struct p
     enum mps_status st = same_interface(it, pred, err);
     if (st)
         return st;
+    const size_t len = coupling_iter_len(it);
+    memcpy(it->pred_e, it->in, len * sizeof *it->pred_e);
     for (size_t k = 0; k < it->n; k++)
-        if (!it->fixed[k])
-            for (int a = 0; a < MPS_DIM; a++)
-                it->in[MPS_DIM * k + a] = pred->x[k][a];
+        for (int a = 0; a < MPS_DIM; a++) {
+            size_t q = MPS_DIM * k + (size_t)a;
+            /* clamped particles: the extrapolation keeps them where they are */
+            it->pred_p[q] = it->fixed[k] ? it->pred_e[q] : pred->x[k][a];
+            it->in[q] = it->pred_e[q] + it->w * (it->pred_p[q] - it->pred_e[q]);
+        }
+    it->have_pred = 1;
     unpack(it, it->in, send);
     return MPS_OK;
+}
+
+void coupling_iter_accept(struct coupling_iter *it)
+{
+    if (!it->have_pred)
+        return;
+    const double lambda = 0.9; /* memory of about ten steps */
+    double pp = 0.0, pr = 0.0;
+    for (size_t q = 0; q < coupling_iter_len(it); q++) {
+        double d = it->pred_p[q] - it->pred_e[q], r = it->out[q] - it->pred_e[q];
+        pp += d * d;
+        pr += d * r;
+    }
+    it->s_pp = lambda * it->s_pp + pp;
+    it->s_pr = lambda * it->s_pr + pr;
+    double w = it->s_pp > 0.0 ? it->s_pr / it->s_pp : 1.0;
+    it->w = w < 0.0 ? 0.0 : w > 1.0 ? 1.0 : w;
+    it->have_pred = 0;
 }
 
 enum mps_status coupling_iter_result(struct coupling_iter *it, const struct proto_msg *res,
@@ -203,7 +234,7 @@ enum mps_status coupling_iter_relax(struct coupling_iter *it, struct coupling_ac
 /* The checkpoint's fixed part (coupling_iter_put). */
 struct iter_head {
     int64_t n;
-    double dt_prev;
+    double dt_prev, s_pp, s_pr, w;
 };
 
 enum mps_status coupling_iter_put(const struct coupling_iter *it, struct mps_ckpt *ck,
@@ -213,6 +244,9 @@ enum mps_status coupling_iter_put(const struct coupling_iter *it, struct mps_ckp
     memset(&h, 0, sizeof h);
     h.n = (int64_t)it->n;
     h.dt_prev = it->dt_prev;
+    h.s_pp = it->s_pp;
+    h.s_pr = it->s_pr;
+    h.w = it->w;
     enum mps_status st;
     if ((st = mps_ckpt_put(ck, "iter", &h, sizeof h, err)) ||
         (st = mps_ckpt_put(ck, "iter.id", it->id, it->n * sizeof *it->id, err)) ||
@@ -242,5 +276,8 @@ enum mps_status coupling_iter_get(struct coupling_iter *it, struct mps_ckpt *ck,
         (st = mps_ckpt_get(ck, "iter.x_prev", it->x_prev, it->n * sizeof *it->x_prev, err)))
         return st;
     it->dt_prev = h.dt_prev;
+    it->s_pp = h.s_pp;
+    it->s_pr = h.s_pr;
+    it->w = h.w;
     return MPS_OK;
 }

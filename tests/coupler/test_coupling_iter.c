@@ -102,6 +102,46 @@ int main(void)
     double xq[N][2] = {{0.013, 0.001}, {0.012, 1}, {0, -1}};
     rp.x = (const double(*)[2])xq;
     CHECK(coupling_iter_result(&it, &rp, &conv, &err) == MPS_OK && conv && it.change == 0.0);
+    /* the weight (coupling_iter_accept): 1 before any fit. Three steps from
+     * the state rest0 (the interface at rest: the extrapolation e = rest0),
+     * the prediction moving particle 0 by +4 mm in x, the answers at e + 2,
+     * e + 20 and e - 500 mm: w = (sum of d.r, decayed) / (sum of d.d,
+     * decayed), clamped to [0, 1] */
+    {
+        CHECK(it.w == 1.0);
+        double r0[N][2] = {{0.1, 0.0}, {0.1, 1.0}, {0.0, -1.0}}, still0[N][2] = {{0}};
+        struct proto_msg rest0 = state(r0, still0);
+        const double shift[3] = {0.002, 0.02, -0.5};
+        double w_want[3], spp = 0.0, spr = 0.0;
+        for (int s3 = 0; s3 < 3; s3++) {
+            it.dt_prev = 0.0;  /* no history: e = rest0 + 0 dt */
+            CHECK(coupling_iter_start(&it, &rest0, dt, &send, &err) == MPS_OK);
+            CHECK(send.x[0][0] == 0.1);
+            double pxs[N][2] = {{0.104, 0.0}, {0.1, 1.0}, {0.0, -1.0}};
+            struct proto_msg pp = state(pxs, still0);
+            double w_before = it.w;
+            CHECK(coupling_iter_predicted(&it, &pp, &send, &err) == MPS_OK);
+            CHECK_NEAR(send.x[0][0], 0.1 + w_before * 0.004, 1e-15);
+            double ans[N][2] = {{0.1 + shift[s3], 0.0}, {0.1, 1.0}, {0.0, -1.0}};
+            struct proto_msg ra = state(ans, still0);
+            CHECK(coupling_iter_result(&it, &ra, &conv, &err) == MPS_OK);
+            coupling_iter_accept(&it);
+            spp = 0.9 * spp + 0.004 * 0.004;
+            spr = 0.9 * spr + 0.004 * shift[s3];
+            w_want[s3] = spr / spp < 0.0 ? 0.0 : spr / spp > 1.0 ? 1.0 : spr / spp;
+            CHECK_NEAR(it.w, w_want[s3], 1e-12);
+        }
+        CHECK_NEAR(w_want[0], 0.5, 1e-12);
+        CHECK(w_want[1] == 1.0 && w_want[2] == 0.0);
+        /* a step without a prediction leaves the weight as it is */
+        CHECK(coupling_iter_start(&it, &rest0, dt, &send, &err) == MPS_OK);
+        CHECK(coupling_iter_result(&it, &rest0, &conv, &err) == MPS_OK);
+        coupling_iter_accept(&it);
+        CHECK(it.w == 0.0);
+        it.w = 1.0;
+        it.s_pp = it.s_pr = 0.0;
+    }
+
     /* a prediction of another interface is refused */
     int swapped[N] = {7, 4, 9};
     pred.id = swapped;
@@ -144,9 +184,14 @@ int main(void)
     struct mps_ckpt ck = {0};
     CHECK(coupling_iter_init(&run, &ready, 0.1, 1e-4, &err) == MPS_OK);
     CHECK(coupling_iter_start(&run, &ready, dt, &send, &err) == MPS_OK);
+    run.w = 0.3; /* the prediction's weight and its sums come back too */
+    run.s_pp = 2.5e-6;
+    run.s_pr = 0.75e-6;
     CHECK(coupling_iter_put(&run, &ck, &err) == MPS_OK);
     CHECK(coupling_iter_init(&back, &r1, 0.1, 1e-4, &err) == MPS_OK);
+    CHECK(back.w == 1.0);
     CHECK(coupling_iter_get(&back, &ck, &err) == MPS_OK);
+    CHECK(back.w == 0.3 && back.s_pp == 2.5e-6 && back.s_pr == 0.75e-6);
     /* (the velocity reported at the restart, zero here, is not what the
      * step's prediction takes: only the first step uses one) */
     struct proto_msg send_b, r1s = state(x1, still);
