@@ -626,9 +626,10 @@ static void count_iterations(struct coupler *c, int k)
     c->iter_hist[b]++;
 }
 
-/* The first iterate from the solid alone (coupling.implicit.predictor:
- * solid): it takes the step under the last step's loads, which c->loads
- * still holds, as iteration 0 of its own; the iterations with the fluid
+/* The solid's prediction for the first iterate (coupling.implicit.predictor:
+ * solid; blended with the extrapolation by coupling_iter_predicted): the
+ * solid takes the step under the last step's loads, which c->loads still
+ * holds, as iteration 0 of its own; the iterations with the fluid
  * then repeat the step from its start as the solid's iterations 1, 2, ...
  * (PROTOCOL.md 6: each solver numbers the iterations it is sent). Before
  * the first step there are no loads, and that step extrapolates. */
@@ -826,7 +827,6 @@ static enum mps_status get_loads(struct mps_ckpt *ck, struct proto_msg *l, struc
     }
     return MPS_OK;
 }
-
 
 static enum mps_status put_implicit(const struct coupler *c, struct mps_ckpt *ck,
                                     struct mps_err *err)

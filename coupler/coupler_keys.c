@@ -29,8 +29,9 @@ const struct mps_key_spec coupler_case_keys[] = {
      "aitken|iqn_ils|constant", "",
      "how the next iterate of the interface is chosen (coupler/coupling_accel.h)"},
     {"coupling.implicit.predictor", MPS_KEY_ENUM, "solid", 0, 0, 0, "solid|extrapolate", "",
-     "the first iterate of a step: solid, the solid advanced alone over the step under the "
-     "last step's loads; extrapolate, the interface's last step repeated"},
+     "the first iterate of a step: solid, the extrapolated interface moved towards where the "
+     "solid gets alone under the last step's loads, by a weight fitted to past steps; "
+     "extrapolate, the interface's last step repeated"},
     {"coupling.implicit.relaxation", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "initial relaxation factor of each step (aitken, iqn_ils without columns); the factor "
      "of constant"},

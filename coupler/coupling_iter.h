@@ -89,9 +89,10 @@ void coupling_iter_free(struct coupling_iter *it);
 enum mps_status coupling_iter_start(struct coupling_iter *it, const struct proto_msg *now,
                                     double dt, struct proto_msg *send, struct mps_err *err);
 
-/* After coupling_iter_start, the first input replaced by the interface of
- * pred, a STATE of the solid advanced alone over the step (the same
- * interface as READY's, clamped particles kept where they are). */
+/* After coupling_iter_start, the first input (the extrapolation) moved
+ * towards the interface of pred, a STATE of the solid advanced alone over
+ * the step (the same interface as READY's), by the fitted weight; clamped
+ * particles are kept where they are. */
 enum mps_status coupling_iter_predicted(struct coupling_iter *it, const struct proto_msg *pred,
                                         struct proto_msg *send, struct mps_err *err);
 
