@@ -316,6 +316,17 @@ static void test_timer_progress(void)
     mps_progress_update(&p, 0.5, 10);
     mps_progress_finish(&p, 1.0, 20);
     CHECK(p.printed == 0);
+
+    /* the ETA of a restart: resumed at 9.9 s of a run to 10 s, halfway after
+     * 10 s of wall time the rest takes 10 s more (the first update is the
+     * baseline and prints nothing) */
+    struct mps_progress r;
+    mps_progress_init(&r, "coupled", 10.0, 0);
+    CHECK(mps_progress_eta(&r, 9.9, mps_wall_seconds()) < 0.0); /* no update yet */
+    mps_progress_update(&r, 9.9, 24157);
+    CHECK(r.printed == 0);
+    CHECK(mps_progress_eta(&r, 9.9, r.wall_base + 1.0) < 0.0); /* no progress yet */
+    CHECK_NEAR(mps_progress_eta(&r, 9.95, r.wall_base + 10.0), 10.0, 1e-9);
 }
 
 int main(void)
