@@ -95,6 +95,11 @@ def run_list():
                                          None)
         r[f'{case}_1_tlsph_implicit'] = (case, ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
                                                 'output.interval=0.1'], TLSPH)
+    # The low filling at 0.5 mm (thirty-first session): the plate's lattice
+    # at 0.5 mm (solid.refine=1), the 1 mm case's, since the case's refine=2
+    # would be 0.25 mm there, four times the solid's particles at half its step
+    r['low_0.5_mps_implicit'] = ('low', ['dp=0.0005', 'solid.refine=1', 'fluid.dt_max=5e-4',
+                                         'coupling.scheme=implicit', 'output.interval=0.1'], None)
     # the measured roll at 1 mm with the case's setting (twenty-ninth session),
     # against high_1_mps_implicit over the cycles both hold
     r['high_1_mps_implicit_table'] = ('high', ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
