@@ -164,6 +164,24 @@ int main(void)
         CHECK(coupling_iter_result(&it, &r4, &conv, &err) == MPS_OK && conv == !pass);
     }
 
+    /* the relative test's edge: particles 0 and 1 answer delta beyond the
+     * first input x0 + v0 dt (so the step's increment is dt + delta for
+     * them, the change delta); converged iff
+     * delta <= (tol dt + atol dt / sqrt(2/3)) / (1 - tol), both RMS over
+     * the 3 particles. 1% on either side of that edge */
+    coupling_iter_free(&it);
+    CHECK(coupling_iter_init(&it, &ready, 0.1, 1e-4, &err) == MPS_OK);
+    const double edge = (0.1 * 0.01 + 1e-4 * dt / sqrt(2.0 / 3.0)) / (1.0 - 0.1);
+    for (int pass = 0; pass < 2; pass++) {
+        it.dt_prev = 0.0; /* no history: x0 + v0 dt */
+        CHECK(coupling_iter_start(&it, &ready, dt, &send, &err) == MPS_OK);
+        CHECK_NEAR(send.x[0][0], 0.01, 1e-15);
+        const double delta = (pass ? 1.01 : 0.99) * edge;
+        double x5[N][2] = {{0.01 + delta, 0}, {0.01 + delta, 1}, {0, -1}};
+        struct proto_msg r5 = state(x5, v1);
+        CHECK(coupling_iter_result(&it, &r5, &conv, &err) == MPS_OK && conv == !pass);
+    }
+
     /* another interface (fracture): refused with a message */
     int other[N] = {4, 8, 9};
     struct proto_msg bad = state(x1, v1);

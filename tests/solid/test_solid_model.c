@@ -21,9 +21,10 @@ static void clamp_probe_test(int rows)
     sc.g[1] = -9.81;
     sc.nclamps = 1;
     sc.clamps[0] = (struct solid_clamp_def){0, -0.03, 0.0, 0.0, rows * 0.01};
-    sc.nprobes = 2;
+    sc.nprobes = 3;
     sc.probes[0] = (struct solid_probe_def){"tip", SOLID_PROBE_DY, 0.4, 0.5 * rows * 0.01, -1};
     sc.probes[1] = (struct solid_probe_def){"root_y", SOLID_PROBE_Y, -0.015, 0.0, -1};
+    sc.probes[2] = (struct solid_probe_def){"tip_dx", SOLID_PROBE_DX, 0.4, 0.5 * rows * 0.01, -1};
     struct solid_mps *m = make_model(&sc);
     CHECK(m->n - m->nfree == (size_t)(3 * rows));
     CHECK(m->probe_n[0] == (rows % 2 ? 1 : 2));
@@ -44,13 +45,17 @@ static void clamp_probe_test(int rows)
            "clamp moved %.3g\n", rows, tip, m->probe_n[0], moved);
     CHECK(moved == 0.0);
     CHECK(tip < 0.0);
-    /* the tip probe is the mean of its particles */
-    double mean = 0.0;
+    /* the tip probes are the mean of their particles' displacement (dx:
+     * the bent strip's tip moves back, by about tip^2 / length) */
+    double mean = 0.0, mean_x = 0.0;
     for (int a = 0; a < m->probe_n[0]; a++) {
         size_t i = m->probe_i[0][a];
         mean += (m->x[i][1] - m->x0[i][1]) / m->probe_n[0];
+        mean_x += (m->x[i][0] - m->x0[i][0]) / m->probe_n[0];
     }
     CHECK_NEAR(tip, mean, 1e-15);
+    CHECK(m->probe_n[2] == m->probe_n[0] && fabs(mean_x) > 1e-9);
+    CHECK_NEAR(solid_mps_probe(m, 2), mean_x, 1e-12 * fabs(mean_x));
     solid_mps_destroy(&m);
 }
 
