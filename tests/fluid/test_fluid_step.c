@@ -142,6 +142,15 @@ static void test_still_water(void)
      * 1.2e-3 m/s; the issue's target is 0.0172 m/s over 2 s */
     CHECK(eps < 5.0);
     CHECK(vmax < 2e-3);
+    /* the case's probe 0, the pressure on the floor: the floor's wall
+     * particles, carried up dp/2 to y = 0 */
+    double pb = fluid_probe(f, 0), pb_want = rho * g * ys;
+    printf("still water, 10 steps: bottom_pressure %.2f Pa, rho g (h - dp/2) %.2f Pa\n", pb,
+           pb_want);
+    /* measured 0.16 Pa off; 1 Pa is four times the water's own largest
+     * deviation above, and a tenth of the carry rho g dp / 2 = 49 Pa wrong
+     * (a 10% error in it) is 4.9 Pa */
+    CHECK(fabs(pb - pb_want) < 1.0);
     fluid_destroy(&f);
     CHECK(f == NULL);
 }
