@@ -293,6 +293,10 @@ static void test_droplet_step(void)
         if (m == 1) { /* a droplet with 3 neighbours is not one */
             f->ncount[i] = 3;
             CHECK_NEAR(fluid_cfl_dt(f), f->prm.courant * f->prm.dp / 40.0, 1e-12);
+            /* a viscous fluid: the explicit viscosity's limit 0.2 dp^2 / nu
+             * (8e-5 s at nu = 1 m^2/s) below the Courant step (1e-4 s) */
+            f->prm.nu = 1.0;
+            CHECK_NEAR(fluid_cfl_dt(f), 0.2 * f->prm.dp * f->prm.dp / 1.0, 1e-15);
         }
         fluid_destroy(&f);
     }
