@@ -104,7 +104,8 @@ struct coupler {
     long step;
     double wall0;
     char failed_peer[16];
-    int case_error;            /* a solver's case error (PROTOCOL.md 8) ended the run */
+    int case_error;            /* a case error ended the run: a solver's (PROTOCOL.md 8),
+                                * or a solid step the case makes impossible */
     /* implicit coupling (coupling.scheme: implicit) */
     int implicit;
     struct coupling_iter iter;
@@ -591,10 +592,26 @@ static double next_dt(const struct coupler *c, double t_next, double probe_inter
 }
 
 /* Sub-cycles from the solid's own stable step (paper 4.6). */
-static int solid_substeps(const struct coupler *c, double dt)
+/* The solid's sub-steps for a coupling step of dt at its stable step (READY).
+ * A solid whose stable step is absurdly short (E = 1e30 Pa) needs more than
+ * an ADVANCE's int32 carries: said here, naming the cause, where before the
+ * count wrapped to a negative n_sub that the solid refused as a protocol
+ * error. */
+static enum mps_status solid_substeps(struct coupler *c, double dt, int *n_sub,
+                                      struct mps_err *err)
 {
     double n = ceil(dt / c->p[SOLID].dt * (1.0 - 1e-12));
-    return n < 1.0 ? 1 : (int)n;
+    if (!(n <= (double)INT32_MAX)) {
+        c->case_error = 1; /* said in one line, as a key's error */
+        return mps_err_set(err, MPS_EINPUT,
+                           "%s: the solid's stable step %.3g s needs %.3g sub-steps for a "
+                           "coupling step of %.3g s, more than an ADVANCE carries (%d): check "
+                           "the solid's E, rho and dp",
+                           c->cs ? mps_case_path(c->cs) : "case", c->p[SOLID].dt, n, dt,
+                           (int)INT32_MAX);
+    }
+    *n_sub = n < 1.0 ? 1 : (int)n;
+    return MPS_OK;
 }
 
 /* The fluid's loads for the solid's ADVANCE, as built from adv. */
@@ -662,10 +679,12 @@ static enum mps_status solid_prediction(struct coupler *c, struct proto_msg *adv
 static enum mps_status implicit_step(struct coupler *c, struct proto_msg *adv,
                                      struct mps_err *err)
 {
-    const int n_sub = solid_substeps(c, adv->dt);
+    int n_sub = 1;
     struct proto_msg send;
     double a0 = mps_wall_seconds();
-    enum mps_status st = coupling_iter_start(&c->iter, &c->state, adv->dt, &send, err);
+    enum mps_status st = solid_substeps(c, adv->dt, &n_sub, err);
+    if (!st)
+        st = coupling_iter_start(&c->iter, &c->state, adv->dt, &send, err);
     if (!st)
         st = coupling_accel_begin(c->accel, coupling_iter_len(&c->iter), err);
     c->accel_seconds += mps_wall_seconds() - a0;
@@ -991,7 +1010,10 @@ static enum mps_status run_loop(struct coupler *c, struct mps_err *err)
             c->impulse_time += dt;
         }
         if (!c->implicit && c->p[SOLID].needed) {
-            struct proto_msg sadv = solid_advance(c, &adv, solid_substeps(c, dt));
+            int n_sub = 1;
+            if ((st = solid_substeps(c, dt, &n_sub, err)))
+                return st;
+            struct proto_msg sadv = solid_advance(c, &adv, n_sub);
             if ((st = exchange(c, SOLID, &sadv, &res, err)))
                 return st;
             proto_msg_clear(&c->state);
