@@ -591,8 +591,8 @@ static double next_dt(const struct coupler *c, double t_next, double probe_inter
     return dt;
 }
 
-/* Sub-cycles from the solid's own stable step (paper 4.6). */
-/* The solid's sub-steps for a coupling step of dt at its stable step (READY).
+/* The solid's sub-cycles for a coupling step of dt at its own stable step
+ * (paper 4.6; the step READY reported).
  * A solid whose stable step is absurdly short (E = 1e30 Pa) needs more than
  * an ADVANCE's int32 carries: said here, naming the cause, where before the
  * count wrapped to a negative n_sub that the solid refused as a protocol

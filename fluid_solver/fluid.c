@@ -283,13 +283,7 @@ double fluid_cfl_dt(const struct fluid *f)
     }
     if (vdrop2 > 0.0 && f->prm.dp / sqrt(vdrop2) < dt)
         dt = f->prm.dp / sqrt(vdrop2);
-    /* Explicit viscosity (Eq. 16) is stable for dt < dp^2 / (2 d nu) roughly. */
-    if (f->prm.nu > 0.0) {
-        double dv = 0.2 * f->prm.dp * f->prm.dp / f->prm.nu;
-        if (dv < dt)
-            dt = dv;
-    }
-    return dt;
+    return fmin(dt, fluid_viscous_dt(&f->prm));
 }
 
 /* Numbers the fluid segment in the grid's cell order (the grid follows). */

@@ -472,11 +472,11 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
                              p->courant * p->dp / vexp, vexp);
     /* So must the viscous limit, which fluid_cfl_dt applies at every step:
      * otherwise the first step fails with a message about speeds. */
-    if (p->nu > 0.0 && 0.2 * p->dp * p->dp / p->nu < p->dt_min)
+    if (fluid_viscous_dt(p) < p->dt_min)
         return mps_case_fail(c, err, "fluid.nu",
                              "the explicit viscosity (Eq. 16) needs dt <= 0.2 dp^2 / nu = %.3g s, "
                              "below fluid.dt_min = %.3g s",
-                             0.2 * p->dp * p->dp / p->nu, p->dt_min);
+                             fluid_viscous_dt(p), p->dt_min);
 
     p->nprobes = mps_case_count(c, "fluid.probes");
     if (p->nprobes > FLUID_MAX_PROBES)
@@ -494,4 +494,9 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
             return st;
     }
     return MPS_OK;
+}
+
+double fluid_viscous_dt(const struct fluid_params *p)
+{
+    return p->nu > 0.0 ? 0.2 * p->dp * p->dp / p->nu : INFINITY;
 }

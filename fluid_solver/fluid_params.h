@@ -119,4 +119,9 @@ extern const char *const fluid_wall_names[FLUID_NWALLS];
 enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case *c,
                                   struct mps_err *err);
 
+/* The explicit viscosity's (Eq. 16) stable step, roughly dp^2 / (2 d nu);
+ * INFINITY for an inviscid fluid. One definition for the step limit and for
+ * the check at reading that it is not below dt_min. */
+double fluid_viscous_dt(const struct fluid_params *p);
+
 #endif
