@@ -100,6 +100,11 @@ def run_list():
     # would be 0.25 mm there, four times the solid's particles at half its step
     r['low_0.5_mps_implicit'] = ('low', ['dp=0.0005', 'solid.refine=1', 'fluid.dt_max=5e-4',
                                          'coupling.scheme=implicit', 'output.interval=0.1'], None)
+    # The high filling at 0.5 mm (thirty-third session): the case as it is
+    # (its plate unrefined, 8 particles across at 0.5 mm); started, not finished
+    r['high_0.5_mps_implicit'] = ('high', ['dp=0.0005', 'fluid.dt_max=5e-4',
+                                           'coupling.scheme=implicit', 'output.interval=0.1'],
+                                  None)
     # the measured roll at 1 mm with the case's setting (twenty-ninth session),
     # against high_1_mps_implicit over the cycles both hold
     r['high_1_mps_implicit_table'] = ('high', ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',
