@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """How hard the implicit coupling works in a run (docs/sloshing.md, "The
-coupling stiffens as the oil is refined").
+coupling stiffens below 1 mm").
 
 usage: bench/coupling_iterations.py RUN [RUN ...] [--window T0 T1 ...]
 

@@ -3,14 +3,24 @@
 plate's force noise: where it is").
 
 usage: bench/plate_force_noise.py RUN [RUN ...] [--after 0.7] [--before 1.25]
-                                  [--snapshots] [--dp DP]
+                                  [--snapshots] [--dp DP] [--column solid_fx]
+                                  [--split T] [--spectrum]
 
 For each RUN (a coupled run of cases/dambreak_elastic_plate):
 - the issue's measure (tests/coupler/check_plate_flicker.py): the share of
   the 2 ms force rows within 15% of their 20 ms running mean, split into the
   rows where that mean is at least 10% of the peak ("loaded") and the rest
   ("quiet"), where the band is the floor's absolute 1.5% of the peak. Needs
-  probes every 2 ms (the case's output.probe_interval);
+  probes every 2 ms (the case's output.probe_interval). --column names the
+  force (default solid_fx, the solid's; plate_force_x is the fluid's, which
+  a rigid plate held by the fake solid also has). --split T also splits the
+  measure at time T, and with several runs prints the mean +- standard error
+  over them of the measure and of its two parts, and the mean RMS deviation
+  and force peak. --spectrum prints, for the
+  first run, the RMS of the 2 ms rows' deviation from their 20 ms mean in
+  each 0.1 s from 0.1 s, and over all runs the power spectrum of that
+  deviation over 0.12-0.63 s (256 rows of the case's 2 ms, Hann window) in
+  8 Hz bands;
 - with probes finer than the fluid's step (output.probe_interval=2.5e-4: a
   probe row then holds one coupling step's load), the RMS of the step loads'
   deviation from their running mean over about 20 ms, and its lag-1
@@ -39,22 +49,38 @@ import yaml
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, 'tests', 'coupler'))
-from check_plate_flicker import force_series_smoothness, probes_table  # noqa: E402
+from check_plate_flicker import force_series_smoothness, probes_table, running_mean  # noqa: E402
 
 WINDOW = 0.02  # s: the issue's running mean
 TANK_RIGHT = 0.584  # m: the case's tank width
 
 
-def split_within15(t, fx):
+def split_within15(t, fx, split=None):
     """The issue's measure (check_plate_flicker.force_series_smoothness)
     split by the running mean's size: (all, loaded, quiet, share of quiet
-    rows) and the quiet rows' RMS deviation from the mean (N/m), or None for
-    probes finer than 1.5 ms."""
+    rows), the quiet rows' RMS deviation from the mean (N/m) and the whole
+    result (with the split in time, if asked), or None for probes finer than
+    1.5 ms."""
     if np.median(np.diff(t)) < 1.5e-3:
         return None
-    r = force_series_smoothness(t, fx)
+    r = force_series_smoothness(t, fx, split)
     return (r['within15'], r['within15_loaded'], r['within15_quiet'], r['quiet_share']), \
-        r['quiet_rms_dev']
+        r['quiet_rms_dev'], r
+
+
+def deviation(t, fx):
+    """The rows' deviation from their centred 20 ms running mean."""
+    return fx - running_mean(t, fx)
+
+
+def deviation_spectrum(series):
+    """The summed power spectrum of deviation() over 0.12-0.63 s of each
+    (t, fx) series, normalised to 1, and its frequencies (Hz)."""
+    n, spec = 256, 0.0
+    for t, fx in series:
+        d = deviation(t, fx)[(t >= 0.12) & (t < 0.632)][:n]
+        spec = spec + np.abs(np.fft.rfft(d * np.hanning(n))) ** 2
+    return np.fft.rfftfreq(n, 0.002), spec / spec.sum()
 
 
 def step_noise(t, fx, probe_interval, after, before):
@@ -161,8 +187,14 @@ def main():
     ap.add_argument('--before', type=float, default=1.25)
     ap.add_argument('--snapshots', action='store_true')
     ap.add_argument('--dp', type=float, default=None, help='the fluid spacing (for --snapshots)')
+    ap.add_argument('--column', default='solid_fx', help='the force column (default solid_fx)')
+    ap.add_argument('--split', type=float, default=None, metavar='T',
+                    help='also the measure before and from T s')
+    ap.add_argument('--spectrum', action='store_true',
+                    help='the deviation per 0.1 s (first run) and its spectrum (all runs)')
     a = ap.parse_args()
     status = 0
+    splits, series = [], []
     for run in a.runs:
         path = os.path.join(run, 'probes.csv')
         if not os.path.exists(path):
@@ -170,13 +202,24 @@ def main():
             status = 1
             continue
         p = probes_table(path)
-        t, fx = p['time'], p['solid_fx']
+        if a.column not in p.dtype.names:
+            print(f'{run}: probes.csv has no column {a.column}', file=sys.stderr)
+            status = 1
+            continue
+        t, fx = p['time'], p[a.column]
+        series.append((t, fx))
         parts = [run]
-        s = split_within15(t, fx)
+        s = split_within15(t, fx, a.split)
         if s:
             parts.append('2 ms rows within 15%%: %.1f%% (loaded %.1f%%, quiet %.1f%%; quiet rows %.0f%%)'
                          % tuple(100 * v for v in s[0]) + ', quiet rows off their mean by %.2f N/m RMS'
                          % s[1])
+            if a.split is not None:
+                r = s[2]
+                splits.append((100 * r['within15'], 100 * r['within15_before'],
+                               100 * r['within15_after'], r['rms_dev'], r['peak']))
+                parts.append('before %g s %.1f%%, from it %.1f%%'
+                             % (a.split, 100 * r['within15_before'], 100 * r['within15_after']))
         with open(os.path.join(run, 'case_resolved.yml')) as f:
             case = yaml.safe_load(f)
         pi = float(case['output']['probe_interval'])
@@ -199,6 +242,23 @@ def main():
             parts.append('step change next to the plate %.0f Pa and %.4f m/s, the right wall '
                          '%.0f Pa and %.4f m/s' % (q['plate'] + q['right wall']))
         print(' | '.join(parts))
+    if len(splits) > 1:
+        v = np.array(splits)
+        mean, se = v.mean(0), v.std(0, ddof=1) / np.sqrt(len(v))
+        print('%d runs, rows within 15%%: all %.1f +- %.1f%%, before %g s %.1f +- %.1f%%, '
+              'from it %.1f +- %.1f%%; RMS deviation %.1f N/m, peak %.0f N/m (means)'
+              % (len(v), mean[0], se[0], a.split, mean[1], se[1], mean[2], se[2], mean[3],
+                 mean[4]))
+    if a.spectrum and series:
+        t, fx = series[0]
+        d = deviation(t, fx)
+        print('deviation per 0.1 s from 0.1 s, N/m RMS: ' + ' '.join(
+            '%.1f' % np.sqrt(np.mean(d[(t >= b) & (t < b + 0.1)] ** 2))
+            for b in np.arange(0.1, t[-1] - 0.05, 0.1)))
+        f, pw = deviation_spectrum(series)
+        print('its spectrum, 0.12-0.63 s, %d runs: ' % len(series) + ' '.join(
+            '%.0f-%.0f Hz %.0f%%' % (f[i], f[i + 3], 100 * pw[i:i + 4].sum())
+            for i in range(0, len(f) - 3, 4)))
     return status
 
 

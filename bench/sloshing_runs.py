@@ -102,9 +102,10 @@ def run_list():
                                          'coupling.scheme=implicit', 'output.interval=0.1'], None)
     # The high filling at 0.5 mm (thirty-third session): the case as it is
     # (its plate unrefined, 8 particles across at 0.5 mm); started, not finished
+    # (with the iteration log that bench/coupling_iterations.py reads)
     r['high_0.5_mps_implicit'] = ('high', ['dp=0.0005', 'fluid.dt_max=5e-4',
-                                           'coupling.scheme=implicit', 'output.interval=0.1'],
-                                  None)
+                                           'coupling.scheme=implicit', 'output.interval=0.1',
+                                           'coupling.implicit.log=true'], None)
     # the measured roll at 1 mm with the case's setting (twenty-ninth session),
     # against high_1_mps_implicit over the cycles both hold
     r['high_1_mps_implicit_table'] = ('high', ['fluid.dt_max=5e-4', 'coupling.scheme=implicit',

@@ -71,12 +71,19 @@ def face_breathing(run_dir, after=0.3):
     return float(np.sqrt(np.mean(np.square(diffs)))) if diffs else float('nan')
 
 
-def force_series_smoothness(t, fx):
-    """force_smoothness on a force series fx at times t."""
+def running_mean(t, fx):
+    """The centred 20 ms running mean of a series fx at times t."""
+    w = max(1, int(round(0.02 / np.median(np.diff(t)))))
+    return np.convolve(fx, np.ones(w) / w, mode='same')
+
+
+def force_series_smoothness(t, fx, split=None):
+    """force_smoothness on a force series fx at times t; with split (s), also
+    the share within 15% of the rows before and from that time
+    (within15_before, within15_after)."""
     peak = np.abs(fx).max()
     t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
-    w = max(1, int(round(0.02 / np.median(np.diff(t)))))
-    mean = np.convolve(fx, np.ones(w) / w, mode='same')
+    mean = running_mean(t, fx)
     m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
     dev = np.abs(fx - mean)[m]
     ref = np.maximum(np.abs(mean[m]), 0.1 * peak)
@@ -84,7 +91,12 @@ def force_series_smoothness(t, fx):
     # "quiet": rows whose mean is under the floor, where the band is an
     # absolute 1.5% of the peak (bench/plate_force_noise.py splits by it)
     quiet = np.abs(mean[m]) < 0.1 * peak
-    return {'first_impact_s': float(t0), 'peak': float(peak),
+    halves = {}
+    if split is not None:
+        early = t[m] < split
+        halves = {'within15_before': float(np.mean(ok[early])) if early.any() else float('nan'),
+                  'within15_after': float(np.mean(ok[~early])) if (~early).any() else float('nan')}
+    return {**halves,'first_impact_s': float(t0), 'peak': float(peak),
             'within15': float(np.mean(ok)),
             'rms_dev': float(np.sqrt(np.mean(dev ** 2))),
             'step_change': float(np.mean(np.abs(np.diff(fx[m])))),
