@@ -1547,6 +1547,11 @@ static enum mps_status start_run(struct coupler *c, struct mps_err *err)
                   c->iter_log);
         }
     }
+    /* once every program has taken the case (an input error stays the one
+     * line it is); not under --quiet: they say the model is not the one
+     * declared */
+    if (c->p[SOLID].needed && !c->restart)
+        scene_check_lattice(c->cs, c->p[FLUID].needed, stderr);
     if (!c->quiet)
         fprintf(stderr, "coupler: %s%s%s, output in %s\n", c->p[FLUID].needed ? "fluid" : "",
                 c->p[FLUID].needed && c->p[SOLID].needed ? " + " : "",

@@ -115,3 +115,83 @@ enum mps_status scene_check_fsi(const struct mps_case *c, struct mps_err *err)
     }
     return MPS_OK;
 }
+
+/* Lattice points of [lo, hi] at spacing dp, as the solvers fill it (the
+ * tolerance absorbs decimal round-off: 0.304 / 0.0008 gives 380). */
+static long whole_spacings(double lo, double hi, double dp)
+{
+    double n = floor((hi - lo) / dp + 1e-6);
+    return n > 0 ? (long)fmin(n, 1e15) : 0;
+}
+
+/* The gap, in spacings, between a water block ending at a body's face and
+ * the body's first particles, along one axis: block [b0, b1] below, body
+ * [d0, d1] above (or the mirror image). 1 is the lattice; 0 if the two do
+ * not meet there. */
+static double face_gap(double b0, double b1, double d0, double d1, double dp, double tol)
+{
+    if (fabs(b1 - d0) <= tol) /* the water, then the body */
+        return (d0 + 0.5 * dp - (b0 + ((double)whole_spacings(b0, b1, dp) - 0.5) * dp)) / dp;
+    if (fabs(d1 - b0) <= tol) /* the body, then the water */
+        return (b0 + 0.5 * dp - (d0 + ((double)whole_spacings(d0, d1, dp) - 0.5) * dp)) / dp;
+    return 0.0;
+}
+
+int scene_check_lattice(const struct mps_case *c, int with_fluid, FILE *out)
+{
+    const double dp = mps_case_double(c, "dp");
+    const double tol = 1e-3 * dp;
+    const char *path = mps_case_origin(c);
+    const int nbodies = mps_case_count(c, "solid.bodies");
+    const int nblocks = with_fluid ? mps_case_count(c, "fluid.blocks") : 0;
+    static const char *const what[2] = {"width", "height"};
+    int nwarn = 0;
+    for (int b = 0; b < nbodies; b++) {
+        struct rect d;
+        char prefix[64];
+        snprintf(prefix, sizeof prefix, "solid.bodies.%d", b);
+        const char *name = mps_case_text(c, "%s.name", prefix);
+        if (!name || !raw_rect(c, prefix, &d))
+            continue; /* the solid names what is wrong with this body */
+        const double lo[2] = {d.x0, d.y0}, hi[2] = {d.x1, d.y1};
+        for (int a = 0; a < 2; a++) {
+            const double len = hi[a] - lo[a], s = len / dp;
+            const long n = whole_spacings(lo[a], hi[a], dp);
+            if (s - (double)n <= 1e-3)
+                continue;
+            fprintf(out,
+                    "coupler: warning: %s: %s.%s1: body '%s' is %g m in %s, %.3f spacings of "
+                    "dp = %g m: it is built %ld spacings (%g m, %.1f%% less), as its particles "
+                    "fill whole spacings only; a dp that divides %g m builds it as declared\n",
+                    path, prefix, a ? "y" : "x", name, len, what[a], s, dp, n, (double)n * dp,
+                    100.0 * (1.0 - (double)n / s), len);
+            nwarn++;
+        }
+        for (int k = 0; k < nblocks; k++) {
+            struct rect w;
+            char block[64];
+            snprintf(block, sizeof block, "fluid.blocks.%d", k);
+            if (!raw_rect(c, block, &w))
+                continue;
+            /* faces that meet over some length: across x (the rows overlap
+             * in y) or across y */
+            const double gx = fmin(d.y1, w.y1) - fmax(d.y0, w.y0) > tol
+                                  ? face_gap(w.x0, w.x1, d.x0, d.x1, dp, tol) : 0.0;
+            const double gy = fmin(d.x1, w.x1) - fmax(d.x0, w.x0) > tol
+                                  ? face_gap(w.y0, w.y1, d.y0, d.y1, dp, tol) : 0.0;
+            for (int a = 0; a < 2; a++) {
+                const double g = a ? gy : gx;
+                if (g == 0.0 || fabs(g - 1.0) <= 0.01)
+                    continue;
+                fprintf(out,
+                        "coupler: warning: %s: %s: its water stands %.2f spacings from body "
+                        "'%s' across %s instead of 1 (dp = %g m does not divide the block or "
+                        "the body): the pressure beside the body starts wrong, and the first "
+                        "steps close the gap; a dp that divides both avoids it\n",
+                        path, block, g, name, a ? "y" : "x", dp);
+                nwarn++;
+            }
+        }
+    }
+    return nwarn;
+}

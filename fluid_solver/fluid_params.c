@@ -20,7 +20,8 @@ const struct mps_key_spec fluid_case_keys[] = {
      "instead (0: every particle sets it, the paper)"},
     {"fluid.dt_max", MPS_KEY_DOUBLE, "1e-3", 0, 0, POS, NULL, "s", "cap on the fluid step"},
     {"fluid.dt_min", MPS_KEY_DOUBLE, "1e-7", 0, 0, POS, NULL, "s",
-     "smallest step the CFL condition may ask for before the run is declared diverged"},
+     "smallest step the CFL condition may ask for before the run is declared diverged; "
+     "end_time and the output intervals may not be shorter"},
     {"fluid.kappa", MPS_KEY_DOUBLE, "0.01", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "relaxation of the PPE source term (Eq. 23)"},
     {"fluid.kappa_dt", MPS_KEY_DOUBLE, "0", 0, 0, NOHI, NULL, "s",
@@ -477,6 +478,16 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
                              "the explicit viscosity (Eq. 16) needs dt <= 0.2 dp^2 / nu = %.3g s, "
                              "below fluid.dt_min = %.3g s",
                              fluid_viscous_dt(p), p->dt_min);
+    /* a step cut to land on one of these times would be shorter than
+     * dt_min, which the fluid takes for a flow too fast for Eq. 52 */
+    const char *const times[] = {"end_time", "output.interval", "output.probe_interval"};
+    const double tv[] = {p->end_time, p->output_interval, p->probe_interval};
+    for (int k = 0; k < 3; k++)
+        if (tv[k] > 0.0 && tv[k] < p->dt_min)
+            return mps_case_fail(c, err, times[k],
+                                 "shorter than fluid.dt_min = %g s, the shortest step the fluid "
+                                 "takes",
+                                 p->dt_min);
 
     p->nprobes = mps_case_count(c, "fluid.probes");
     if (p->nprobes > FLUID_MAX_PROBES)
