@@ -572,12 +572,22 @@ def t_cpu_placement_auto(allowed):
     # the lock files both took the first allowed CPU). Another test's coupler
     # may hold a CPU meanwhile (ctest -j2), so the second run may find every
     # CPU claimed: it is then left to the OS and must say so.
+    # With a coupler outside this suite holding a CPU as well (a long run in
+    # the background), the other job's coupler can take the last free one
+    # between this count and the two runs' start: neither run is then
+    # pinned, rightly. Only with two or more CPUs free here must one be.
+    free_before = unclaimed_cpus(allowed)
     runs = [start_long_run([]), start_long_run([])]
     seen = [placement_of(p) for p, _ in runs]
     notes = [stop_long_run(p, out) for p, out in runs]
     pinned = [sorted(s['coupler']) for s, n in zip(seen, notes) if 'shared' in n]
-    check(len(pinned) >= 1 and all(len(c) == 1 for c in pinned),
-          f'two runs: at least one pinned to one CPU ({notes}, {[sorted(s["coupler"]) for s in seen]})')
+    if not pinned and len(free_before) < 2 and all('claimed' in n for n in notes):
+        skip(f'two runs: {len(free_before)} CPU free before they started, taken by another '
+             f'coupler meanwhile ({notes}): "at least one pinned" not tested now')
+    else:
+        check(len(pinned) >= 1 and all(len(c) == 1 for c in pinned),
+              f'two runs: at least one pinned to one CPU ({notes}, '
+              f'{[sorted(s["coupler"]) for s in seen]})')
     check(len(pinned) < 2 or pinned[0] != pinned[1],
           f'two runs: not pinned to the same CPU ({pinned})')
     for s, n in zip(seen, notes):
