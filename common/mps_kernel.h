@@ -68,6 +68,19 @@ struct mps_lattice_consts {
     int count;       /* neighbours inside re (N0 of the free-surface check) */
 };
 
+/* Lattice points at lo + (i + 1/2) dp inside [lo, hi]: how many a body, a
+ * water block or a wall fills, whole spacings only (the tolerance absorbs
+ * decimal round-off: 0.584 / 0.004 gives 146, 0.304 / 0.0008 gives 380).
+ * One count for the solvers and the coupler's check of the layout
+ * (coupler/scene_check.h), so the check reads what the solvers build. */
+static inline long mps_lattice_count(double lo, double hi, double dp)
+{
+    double n = floor((hi - lo) / dp + 1e-6);
+    /* capped so the conversion stays defined; the memory checks refuse
+     * such a scene anyway */
+    return n > 0 ? (long)fmin(n, 1e15) : 0;
+}
+
 /* Constants for a particle inside a full square lattice of spacing l0, with
  * effective radius re (both in m). */
 struct mps_lattice_consts mps_lattice_consts(double l0, double re);

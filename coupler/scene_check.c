@@ -6,6 +6,8 @@
 #include <string.h>
 #include <strings.h>
 
+#include "mps_kernel.h"
+
 /* A rectangle of the layout, as the case gives it: PREFIX.x0, y0, x1, y1. */
 struct rect {
     double x0, y0, x1, y1;
@@ -116,14 +118,6 @@ enum mps_status scene_check_fsi(const struct mps_case *c, struct mps_err *err)
     return MPS_OK;
 }
 
-/* Lattice points of [lo, hi] at spacing dp, as the solvers fill it (the
- * tolerance absorbs decimal round-off: 0.304 / 0.0008 gives 380). */
-static long whole_spacings(double lo, double hi, double dp)
-{
-    double n = floor((hi - lo) / dp + 1e-6);
-    return n > 0 ? (long)fmin(n, 1e15) : 0;
-}
-
 /* The gap, in spacings, between a water block ending at a body's face and
  * the body's first particles, along one axis: block [b0, b1] below, body
  * [d0, d1] above (or the mirror image). 1 is the lattice; 0 if the two do
@@ -131,9 +125,9 @@ static long whole_spacings(double lo, double hi, double dp)
 static double face_gap(double b0, double b1, double d0, double d1, double dp, double tol)
 {
     if (fabs(b1 - d0) <= tol) /* the water, then the body */
-        return (d0 + 0.5 * dp - (b0 + ((double)whole_spacings(b0, b1, dp) - 0.5) * dp)) / dp;
+        return (d0 + 0.5 * dp - (b0 + ((double)mps_lattice_count(b0, b1, dp) - 0.5) * dp)) / dp;
     if (fabs(d1 - b0) <= tol) /* the body, then the water */
-        return (b0 + 0.5 * dp - (d0 + ((double)whole_spacings(d0, d1, dp) - 0.5) * dp)) / dp;
+        return (b0 + 0.5 * dp - (d0 + ((double)mps_lattice_count(d0, d1, dp) - 0.5) * dp)) / dp;
     return 0.0;
 }
 
@@ -156,7 +150,7 @@ int scene_check_lattice(const struct mps_case *c, int with_fluid, FILE *out)
         const double lo[2] = {d.x0, d.y0}, hi[2] = {d.x1, d.y1};
         for (int a = 0; a < 2; a++) {
             const double len = hi[a] - lo[a], s = len / dp;
-            const long n = whole_spacings(lo[a], hi[a], dp);
+            const long n = mps_lattice_count(lo[a], hi[a], dp);
             if (s - (double)n <= 1e-3)
                 continue;
             fprintf(out,

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 
 #include "fluid.h"
+#include "mps_kernel.h"
 
 struct pts_buf {
     struct fluid_scene_pt *a;
@@ -37,17 +38,8 @@ static double jitter_unit(unsigned long seed, size_t k, int axis)
     return (double)(z >> 11) * 0x1.0p-52 - 1.0;
 }
 
-/* Number of lattice points with centres at lo + (i + 1/2) dp inside [lo, hi);
- * a tolerance absorbs decimal round-off (0.584 / 0.004 must give 146). */
-static long lattice_count(double lo, double hi, double dp)
-{
-    double c = (hi - lo) / dp;
-    long k = (long)floor(c + 1e-6);
-    return k < 0 ? 0 : k;
-}
-
 /* Wall points along an inner face of length len: the lattice (i + 1/2) dp,
- * i < n = lattice_count(0, len, dp), which ends r = len - n dp short of the
+ * i < n = mps_lattice_count(0, len, dp), which ends r = len - n dp short of the
  * far wall, whose first column stands at len + dp/2. Left so, the last gap
  * is r + dp wide, and when len is not a whole number of spacings particles
  * creep through that corner: the 3 mm dam-break plate (0.584 m is 194.67
@@ -59,13 +51,13 @@ static long lattice_count(double lo, double hi, double dp)
  * wall_point gives point k of it. */
 static long wall_count(double len, double dp)
 {
-    long n = lattice_count(0.0, len, dp);
+    long n = mps_lattice_count(0.0, len, dp);
     return n + (len - n * dp >= 0.5 * dp);
 }
 
 static double wall_point(long k, double len, double dp)
 {
-    long n = lattice_count(0.0, len, dp);
+    long n = mps_lattice_count(0.0, len, dp);
     double r = len - n * dp;
     if (r < 1e-6 * dp || k < n - 1)
         return (k + 0.5) * dp;
@@ -83,7 +75,7 @@ int fluid_scene_build(const struct fluid_params *p, struct fluid_scene_pt **pts,
 
     for (int k = 0; k < p->nblocks; k++) {
         const double *bl = p->block[k];
-        long ni = lattice_count(bl[0], bl[2], dp), nj = lattice_count(bl[1], bl[3], dp);
+        long ni = mps_lattice_count(bl[0], bl[2], dp), nj = mps_lattice_count(bl[1], bl[3], dp);
         for (long j = 0; j < nj; j++)
             for (long i = 0; i < ni; i++)
                 if (push(&b, bl[0] + (i + 0.5) * dp, bl[1] + (j + 0.5) * dp, FLUID_P))
@@ -99,7 +91,7 @@ int fluid_scene_build(const struct fluid_params *p, struct fluid_scene_pt **pts,
      * closed at the far corner by wall_point. The side walls of an open tank
      * keep the plain lattice up to their top, where no corner is closed. */
     long nx = wall_count(W, dp);
-    long ny = p->tank_lid ? wall_count(H, dp) : lattice_count(0.0, H, dp);
+    long ny = p->tank_lid ? wall_count(H, dp) : mps_lattice_count(0.0, H, dp);
     for (int layer = 0; layer < L; layer++) {
         int type = layer == 0 ? WALL_P : DUMMY_P;
         double off = (layer + 0.5) * dp;

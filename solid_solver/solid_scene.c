@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "mps_budget.h"
+#include "mps_kernel.h"
 #include "solid_loadprobe.h"
 
 #define ANY (MPS_KEY_NO_LO | MPS_KEY_NO_HI)
@@ -93,24 +94,14 @@ const struct mps_key_spec solid_case_keys[] = {
     {.name = NULL},
 };
 
-/* Centres at lo + dp/2 + i dp inside [lo, hi]; the tolerance absorbs the
- * rounding of (hi - lo) / dp when the span is a whole number of spacings. */
-static long lattice_count(double lo, double hi, double dp)
-{
-    double n = floor((hi - lo) / dp + 1e-6);
-    /* capped so the conversion stays defined; the memory check refuses
-     * such a body anyway */
-    return n > 0 ? (long)fmin(n, 1e15) : 0;
-}
-
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
 {
     const struct solid_body_def *d = &s->bodies[b];
     /* a scene built by hand (tests) may leave refine 0: unrefined */
     const long k = s->refine > 1 ? s->refine : 1;
     const double dpc = k > 1 ? s->dp_coupling : s->dp;
-    *nx = lattice_count(d->x0, d->x1, dpc) * k;
-    *ny = lattice_count(d->y0, d->y1, dpc) * k;
+    *nx = mps_lattice_count(d->x0, d->x1, dpc) * k;
+    *ny = mps_lattice_count(d->y0, d->y1, dpc) * k;
     if (*nx == 0 || *ny == 0)
         *nx = *ny = 0;
 }

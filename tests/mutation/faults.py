@@ -666,8 +666,8 @@ FAULTS = [
       what='a solid body outside the tank or in a water block is not refused (no solver sees both)',
       hint='broken_case_files'),
     F(id='lattice_gap_misread', eq='the scene across the solvers', file='coupler/scene_check.c',
-      old='return (d0 + 0.5 * dp - (b0 + ((double)whole_spacings(b0, b1, dp) - 0.5) * dp)) / dp;',
-      new='return 1.1 * (d0 + 0.5 * dp - (b0 + ((double)whole_spacings(b0, b1, dp) - 0.5) * dp)) / dp;',
+      old='return (d0 + 0.5 * dp - (b0 + ((double)mps_lattice_count(b0, b1, dp) - 0.5) * dp)) / dp;',
+      new='return 1.1 * (d0 + 0.5 * dp - (b0 + ((double)mps_lattice_count(b0, b1, dp) - 0.5) * dp)) / dp;',
       what='the gap a dp that does not divide the layout leaves between water and a body is '
            'misreported by 10%',
       hint='coupler_lattice_warnings'),
