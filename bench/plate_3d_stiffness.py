@@ -138,9 +138,10 @@ class Plate:
         # three quarters of the model's time)
         B = self.dNdX
         ne, ng = wdet.shape
+        Bw, Bt = B * wdet[..., None, None], np.swapaxes(B, 2, 3)
         FB = np.matmul(B, np.swapaxes(F, 2, 3))          # F_iJ dN_a/dX_J: (e, g, a, i)
-        BBw = np.matmul(B * wdet[..., None, None], np.swapaxes(B, 2, 3))
-        geo = np.matmul(np.matmul(B * wdet[..., None, None], S), np.swapaxes(B, 2, 3))
+        BBw = np.matmul(Bw, Bt)
+        geo = np.matmul(np.matmul(Bw, S), Bt)
         FFt = np.matmul(F, np.swapaxes(F, 2, 3))
         FBw = (FB * wdet[..., None, None]).reshape(ne, ng, 81)
         FBr = FB.reshape(ne, ng, 81)
