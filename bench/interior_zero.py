@@ -25,7 +25,14 @@ any overtops it), and a closing count over all snapshots of all RUNs: the
 snapshots with more than 5% of the interior at P = 0, counting all of it,
 only what lies 1.5 dp or more from the free surface, and only the pool; and
 the share of all the interior particles at P = 0 that lie outside the pool
-(docs/pressure.md, "Where the plate's interior at P = 0 is").
+(docs/pressure.md, "Where the plate's interior at P = 0 is"); then, inside
+and outside the pool, for the interior particles at P = 0, the mean
+pressure of the fluid within 2.1 dp of each (median, 90th percentile and the
+share under 1) in units of rho g dp (`--rho`, default 1000): one particle's
+depth of water, the scale below which a pressure is the air's within the
+resolution. A zero in water around it at that scale is the air's pressure in
+a free jet; a zero in loaded water is a hole in the field. Last, how far the
+zeros in loaded water lie from the nearest free-surface particle.
 --picture PNG --times T ...: draws the first RUN's snapshots nearest to each
 T: the fluid, its free-surface particles grey, the interior at P = 0 red,
 the tank and (from the solid snapshot of that time) the solid black; --box
@@ -78,9 +85,31 @@ def snapshot(fn, dp, deep, pool=None):
     if pool is not None:
         inside = in_pool(x[interior], pool)
         extra = (float(np.mean(zero[inside])) if inside.any() else 0.0,
-                 int(zero.sum()), int((zero & ~inside).sum()))
+                 int(zero.sum()), int((zero & ~inside).sum()),
+                 neighbour_pressure(x, p, fluid, interior, zero, dp, ~inside),
+                 neighbour_pressure(x, p, fluid, interior, zero, dp, inside), int(interior.size),
+                 dist[zero & ~inside], dist[zero & inside])
     return (t, float(zero.mean()), [float(np.mean(zero & b)) for b in bands],
             float(np.mean(areas)) if areas else float('nan'), extra)
+
+
+def neighbour_pressure(x, p, fluid, interior, zero, dp, mask):
+    """For each interior particle at P = 0 selected by mask (over interior):
+    the mean pressure of the fluid within 2.1 dp of it (Eq. 7's radius, the
+    particle itself left out; surface particles count, at their P = 0; walls
+    and solids do not). Near
+    0 where the particle sits in water at the air's pressure (a free jet),
+    large where it is a hole in loaded water."""
+    sel = interior[zero & mask]
+    if not sel.size:
+        return np.zeros(0)
+    idx = np.where(fluid)[0]
+    tree = cKDTree(x[idx])
+    out = []
+    for i, nb in zip(sel, tree.query_ball_point(x[sel], 2.1 * dp)):
+        nb = [j for j in idx[nb] if j != i]
+        out.append(float(np.mean(p[nb])) if nb else 0.0)
+    return np.array(out)
 
 
 def pool_share(fn, pool):
@@ -144,6 +173,8 @@ def main():
     ap.add_argument('--after', type=float, default=0.05)
     ap.add_argument('--deep', type=float, default=3.0)
     ap.add_argument('--pool', type=float, nargs=2, metavar=('XMAX', 'YMAX'))
+    ap.add_argument('--rho', type=float, default=1000.0,
+                    help='the fluid density for the pressure scale rho g dp (--pool)')
     ap.add_argument('--picture')
     ap.add_argument('--times', type=float, nargs='+', default=[])
     ap.add_argument('--box', type=float, nargs=4, metavar=('X0', 'X1', 'Y0', 'Y1'))
@@ -152,8 +183,10 @@ def main():
         if not a.times:
             ap.error('--picture needs --times')
         picture(a.runs[0], a.times, a.picture, a.box)
-    counts = {'snapshots': 0, 'all': 0, 'beyond': 0, 'pool': 0, 'zero': 0, 'outside': 0}
+    counts = {'snapshots': 0, 'all': 0, 'beyond': 0, 'pool': 0, 'zero': 0, 'outside': 0,
+              'holes': 0}
     table = []
+    p_out, p_in, d_loaded = [], [], []
     print('run, t (s): interior at P = 0 | of it: < 1.5 dp, 1.5-%g dp, > %g dp from the '
           'surface | deep cells\' mean area (dp^2)' % (a.deep, a.deep))
     for run in a.runs:
@@ -169,13 +202,20 @@ def main():
             rows.append([s[0], s[1]] + s[2] + [s[3]])
             tail = ''
             if s[4] is not None:
-                tail = ' | pool %5.1f%%' % (100 * s[4][0])
+                holes = np.sum(s[4][3] > a.rho * 9.81 * a.dp) + np.sum(s[4][4] > a.rho * 9.81 * a.dp)
+                tail = ' | pool %5.1f%% | in loaded water %5.1f%%' % (100 * s[4][0],
+                                                                     100.0 * holes / s[4][5])
                 counts['snapshots'] += 1
                 counts['all'] += s[1] > 0.05
                 counts['beyond'] += s[2][1] + s[2][2] > 0.05
                 counts['pool'] += s[4][0] > 0.05
+                counts['holes'] += holes > 0.05 * s[4][5]
                 counts['zero'] += s[4][1]
                 counts['outside'] += s[4][2]
+                p_out.append(s[4][3])
+                p_in.append(s[4][4])
+                head = a.rho * 9.81 * a.dp
+                d_loaded.append(np.concatenate([s[4][6][s[4][3] > head], s[4][7][s[4][4] > head]]))
             print('%s %.4f: %5.1f%% | %5.1f%% %5.1f%% %5.1f%% | %.4f%s'
                   % (run, s[0], 100 * s[1], 100 * s[2][0], 100 * s[2][1], 100 * s[2][2], s[3],
                      tail))
@@ -194,6 +234,23 @@ def main():
               '%.1f%% outside the pool'
               % (c['snapshots'], c['all'], c['beyond'], c['pool'], c['zero'],
                  100.0 * c['outside'] / max(c['zero'], 1)))
+        head = a.rho * 9.81 * a.dp
+        print('snapshots with over 5%% of the interior at P = 0 in loaded water (the fluid within '
+              '2.1 dp above rho g dp on average), of %d: %d' % (c['snapshots'], c['holes']))
+        d = np.concatenate(d_loaded) if d_loaded else np.zeros(0)
+        if d.size:
+            print('the %d zeros in loaded water: distance to the nearest free-surface particle '
+                  'under 1.5 dp %.1f%%, 1.5-3 dp %.1f%%, beyond %.1f%%, median %.2f dp'
+                  % (d.size, 100 * np.mean(d < 1.5), 100 * np.mean((d >= 1.5) & (d < 3)),
+                     100 * np.mean(d >= 3), np.median(d)))
+        for name, ps in (('outside the pool', p_out), ('in the pool', p_in)):
+            ps = np.concatenate(ps) if ps else np.zeros(0)
+            if not ps.size:
+                continue
+            print('interior at P = 0 %s: %d; the mean pressure of the fluid within 2.1 dp of '
+                  'each, in rho g dp (%.1f Pa): median %.2f, 90th percentile %.2f, under 1 '
+                  'for %.1f%%' % (name, ps.size, head, np.median(ps) / head,
+                                  np.percentile(ps, 90) / head, 100.0 * np.mean(ps < head)))
     return 0
 
 

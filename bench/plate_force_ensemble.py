@@ -2,7 +2,7 @@
 """How much of the plate force's deviation from its 20 ms running mean is the
 flow's own (docs/pressure.md, "The decay of Eq. 23's reference step").
 
-usage: bench/plate_force_ensemble.py DIR [--column solid_fx]
+usage: bench/plate_force_ensemble.py DIR [--column solid_fx] [--subsets] [--plot PNG]
 
 DIR: the realisations of bench/flicker_ensemble.py --plate (DIR/1, DIR/2, ...).
 Prints the share of the 2 ms force rows within 15% of their 20 ms running mean
@@ -21,7 +21,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), 'tests', 'coupler'))
-from check_plate_flicker import force_series_smoothness  # noqa: E402
+from check_plate_flicker import force_series_smoothness, judged_rows, running_mean  # noqa: E402
 from probes_csv import probes_table  # noqa: E402
 
 
@@ -29,9 +29,15 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument('dir')
     ap.add_argument('--column', default='solid_fx')
+    ap.add_argument('--plot', metavar='PNG', help='draw one run\'s force and the mean (to 1.2 s)')
+    ap.add_argument('--subsets', action='store_true',
+                    help='the mean of the first 2, 4, 8, ... runs, and the deviation split into '
+                    'what the runs share and what each has of its own')
     a = ap.parse_args()
     runs = sorted((d for d in glob.glob(os.path.join(a.dir, '*'))
-                   if os.path.isfile(os.path.join(d, 'probes.csv'))), key=os.path.basename)
+                   if os.path.isfile(os.path.join(d, 'probes.csv'))),
+                  key=lambda d: (0, int(os.path.basename(d)), '') if os.path.basename(d).isdigit()
+                  else (1, 0, os.path.basename(d)))
     if len(runs) < 2:
         sys.exit('plate_force_ensemble: fewer than two runs with probes.csv in %s' % a.dir)
     tables = [probes_table(os.path.join(r, 'probes.csv')) for r in runs]
@@ -49,6 +55,74 @@ def main():
           '%.0f N/m at %.3f s, smallest %.0f N/m at %.3f s' % (
               len(runs), 100 * em['within15'], em['rms_dev'], mean.max(), t[mean.argmax()],
               mean.min(), t[mean.argmin()]))
+    print('its rows outside 15%%: %s' % (', '.join(
+        '%.3f-%.3f s' % iv for iv in failing_intervals(t, mean)) or 'none'))
+    if a.plot:
+        plot(a.plot, t, forces, mean, a.column)
+    if a.subsets:
+        sizes = [n for n in (2, 4, 8, 16, 32, 64, 128) if n <= len(runs)]
+        if sizes[-1] != len(runs):
+            sizes.append(len(runs))
+        devs = []
+        for n in sizes:
+            m = force_series_smoothness(t, forces[:n].mean(axis=0))
+            devs.append(m['rms_dev'])
+            print('mean of the first %d: within 15%% %.1f%%, RMS deviation %.2f N/m' % (
+                n, 100 * m['within15'], m['rms_dev']))
+        shared, independent = split_deviation(sizes, devs)
+        print('RMS deviation = sqrt(shared^2 + independent^2 / N): shared %.2f N/m (the '
+              'flow the runs have in common), independent %.2f N/m (each run\'s own)' % (
+                  shared, independent))
+
+
+def plot(path, t, forces, mean, column):
+    """One realisation's force and the realisations' mean, each with its 20 ms
+    running mean and the 15% band (floored at 10% of the peak as the measure
+    floors it), the mean's rows outside the band marked."""
+    import matplotlib
+    matplotlib.use('Agg')
+    import matplotlib.pyplot as plt
+    fig, axs = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
+    for ax, fx, title in ((axs[0], forces[0], 'one realisation'),
+                          (axs[1], mean, 'the mean of %d realisations' % len(forces))):
+        rm = running_mean(t, fx)
+        band = 0.15 * np.maximum(np.abs(rm), 0.1 * np.abs(fx).max())
+        ax.fill_between(t, rm - band, rm + band, color='0.85', label='20 ms mean +- 15%')
+        ax.plot(t, fx, lw=0.7, color='tab:blue', label='2 ms rows')
+        for x0, x1 in failing_intervals(t, fx):
+            ax.axvspan(x0 - 0.001, x1 + 0.001, color='tab:red', alpha=0.3, lw=0)
+        ax.set_title('%s: %s (red: rows outside the band)' % (title, column))
+        ax.set_ylabel('N/m')
+        ax.legend(loc='upper right', fontsize=8)
+    axs[1].set_xlabel('t (s)')
+    axs[1].set_xlim(0, min(t[-1], 1.2))
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+
+
+def split_deviation(sizes, devs):
+    """Least squares of dev_N^2 = shared^2 + independent^2 / N over the
+    ensemble sizes N: what the runs share (their common flow's transients,
+    which no number of runs averages away) and what each has of its own
+    (independent between runs, so it falls as 1 / sqrt(N) in their mean).
+    Negative components (noise in the fit) are returned as 0."""
+    A = np.column_stack([np.ones(len(sizes)), 1.0 / np.asarray(sizes, float)])
+    coef = np.linalg.lstsq(A, np.square(devs), rcond=None)[0]
+    return tuple(float(np.sqrt(max(c, 0.0))) for c in coef)
+
+
+def failing_intervals(t, fx, gap=0.005):
+    """The time intervals of the rows outside 15% of their 20 ms mean (the
+    rows force_series_smoothness judges), rows closer than gap s merged."""
+    m, _, ok, _, _ = judged_rows(t, fx)
+    bad = t[m][~ok]
+    out = []
+    for tb in bad:
+        if out and tb - out[-1][1] <= gap:
+            out[-1][1] = tb
+        else:
+            out.append([tb, tb])
+    return [tuple(iv) for iv in out]
 
 
 if __name__ == '__main__':

@@ -77,17 +77,26 @@ def running_mean(t, fx):
     return np.convolve(fx, np.ones(w) / w, mode='same')
 
 
-def force_series_smoothness(t, fx, split=None):
-    """force_smoothness on a force series fx at times t; with split (s), also
-    the share within 15% of the rows before and from that time
-    (within15_before, within15_after)."""
+def judged_rows(t, fx):
+    """The rows the measure judges (after the first impact, |F| above 10% of
+    its peak, and a half window from either end), each row's 20 ms running
+    mean, whether each judged row lies within 15% of it (the mean floored at
+    10% of the peak, where the force passes through zero), the peak and the
+    first impact's time."""
     peak = np.abs(fx).max()
     t0 = t[np.argmax(np.abs(fx) > 0.1 * peak)]
     mean = running_mean(t, fx)
     m = (t >= t0) & (t > t[0] + 0.01) & (t < t[-1] - 0.01)
+    ok = np.abs(fx - mean)[m] <= 0.15 * np.maximum(np.abs(mean[m]), 0.1 * peak)
+    return m, mean, ok, peak, t0
+
+
+def force_series_smoothness(t, fx, split=None):
+    """force_smoothness on a force series fx at times t; with split (s), also
+    the share within 15% of the rows before and from that time
+    (within15_before, within15_after)."""
+    m, mean, ok, peak, t0 = judged_rows(t, fx)
     dev = np.abs(fx - mean)[m]
-    ref = np.maximum(np.abs(mean[m]), 0.1 * peak)
-    ok = dev <= 0.15 * ref
     # "quiet": rows whose mean is under the floor, where the band is an
     # absolute 1.5% of the peak (bench/plate_force_noise.py splits by it)
     quiet = np.abs(mean[m]) < 0.1 * peak

@@ -137,3 +137,20 @@ add_test(NAME coupled_python_modal_solid
          COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler tests/coupler/plate_in_water.yml --out ${CMAKE_BINARY_DIR}/test_out/pymodal --quiet --set end_time=0.3 --solid '/usr/bin/python3 solid_solver/python/modal_beam_solid.py' && /usr/bin/python3 tests/coupler/modal_check.py ${CMAKE_BINARY_DIR}/test_out/pymodal"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupled_python_modal_solid PROPERTIES TIMEOUT 120 LABELS integration)
+
+# bench/plate_force_ensemble.py's split of the plate force's deviation into
+# what the realisations share and what each has of its own, on synthetic runs
+# whose two parts are known (docs/pressure.md, "What a run without noise
+# could reach").
+add_test(NAME bench_force_ensemble_split
+         COMMAND /usr/bin/python3 tests/coupler/test_force_ensemble.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(bench_force_ensemble_split PROPERTIES TIMEOUT 60)
+
+# bench/interior_zero.py's reading of the water around a zero (loaded water
+# or the air's pressure) on lattices whose pressure is known (docs/pressure.md,
+# "What a run without noise could reach").
+add_test(NAME bench_interior_zero_neighbours
+         COMMAND /usr/bin/python3 tests/fluid/test_interior_zero.py
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(bench_interior_zero_neighbours PROPERTIES TIMEOUT 60)
