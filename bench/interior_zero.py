@@ -32,7 +32,10 @@ share under 1) in units of rho g dp (`--rho`, default 1000): one particle's
 depth of water, the scale below which a pressure is the air's within the
 resolution. A zero in water around it at that scale is the air's pressure in
 a free jet; a zero in loaded water is a hole in the field. Last, how far the
-zeros in loaded water lie from the nearest free-surface particle.
+zeros in loaded water lie from the nearest free-surface particle, and the
+snapshots over 5% counting as holes also the zeros `--deep` dp or more from
+the free surface whatever their neighbours (a patch at P = 0 deep in the
+water has zeros around it too).
 --picture PNG --times T ...: draws the first RUN's snapshots nearest to each
 T: the fluid, its free-surface particles grey, the interior at P = 0 red,
 the tank and (from the solid snapshot of that time) the solid black; --box
@@ -184,7 +187,7 @@ def main():
             ap.error('--picture needs --times')
         picture(a.runs[0], a.times, a.picture, a.box)
     counts = {'snapshots': 0, 'all': 0, 'beyond': 0, 'pool': 0, 'zero': 0, 'outside': 0,
-              'holes': 0}
+              'holes': 0, 'patches': 0}
     table = []
     p_out, p_in, d_loaded = [], [], []
     print('run, t (s): interior at P = 0 | of it: < 1.5 dp, 1.5-%g dp, > %g dp from the '
@@ -202,9 +205,15 @@ def main():
             rows.append([s[0], s[1]] + s[2] + [s[3]])
             tail = ''
             if s[4] is not None:
-                holes = np.sum(s[4][3] > a.rho * 9.81 * a.dp) + np.sum(s[4][4] > a.rho * 9.81 * a.dp)
-                tail = ' | pool %5.1f%% | in loaded water %5.1f%%' % (100 * s[4][0],
-                                                                     100.0 * holes / s[4][5])
+                head = a.rho * 9.81 * a.dp
+                holes = np.sum(s[4][3] > head) + np.sum(s[4][4] > head)
+                # a zero deep in the water is a hole even where its neighbours
+                # are zeros too (a patch at P = 0, not a jet's air pressure)
+                patch = (np.sum((s[4][3] > head) | (s[4][6] >= a.deep)) +
+                         np.sum((s[4][4] > head) | (s[4][7] >= a.deep)))
+                tail = ' | pool %5.1f%% | in loaded water %5.1f%% | or deep %5.1f%%' % (
+                    100 * s[4][0], 100.0 * holes / s[4][5], 100.0 * patch / s[4][5])
+                counts['patches'] += patch > 0.05 * s[4][5]
                 counts['snapshots'] += 1
                 counts['all'] += s[1] > 0.05
                 counts['beyond'] += s[2][1] + s[2][2] > 0.05
@@ -214,7 +223,6 @@ def main():
                 counts['outside'] += s[4][2]
                 p_out.append(s[4][3])
                 p_in.append(s[4][4])
-                head = a.rho * 9.81 * a.dp
                 d_loaded.append(np.concatenate([s[4][6][s[4][3] > head], s[4][7][s[4][4] > head]]))
             print('%s %.4f: %5.1f%% | %5.1f%% %5.1f%% %5.1f%% | %.4f%s'
                   % (run, s[0], 100 * s[1], 100 * s[2][0], 100 * s[2][1], 100 * s[2][2], s[3],
@@ -236,7 +244,9 @@ def main():
                  100.0 * c['outside'] / max(c['zero'], 1)))
         head = a.rho * 9.81 * a.dp
         print('snapshots with over 5%% of the interior at P = 0 in loaded water (the fluid within '
-              '2.1 dp above rho g dp on average), of %d: %d' % (c['snapshots'], c['holes']))
+              '2.1 dp above rho g dp on average), of %d: %d; counting also the zeros %g dp or '
+              'more from the free surface: %d' % (c['snapshots'], c['holes'], a.deep,
+                                                  c['patches']))
         d = np.concatenate(d_loaded) if d_loaded else np.zeros(0)
         if d.size:
             print('the %d zeros in loaded water: distance to the nearest free-surface particle '
