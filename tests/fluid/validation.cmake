@@ -102,6 +102,9 @@ add_test(NAME fluid_pressure_flicker_steps
 # right wall, where the CFL step drops); with the walls fixed 2.9 snapshots
 # over per realisation. The band is the target itself: 5% is 1.5 points above
 # the worst realisation, and one impact step that goes wrong reads 40-60%.
+# Seeds 1-8 are a good draw for the defaults: over seeds 1-32 (2026-12-06) 13
+# of 32 realisations have a snapshot over 5% (docs/pressure.md, "What a run
+# without noise could reach"), so this guards a regression, not the target.
 add_test(NAME fluid_dambreak_flicker_realisations
   COMMAND sh -c "rm -rf '${FV_OUT}/flicker_realisations' && /usr/bin/python3 bench/flicker_ensemble.py --build '${CMAKE_BINARY_DIR}' --runs 8 --out '${FV_OUT}/flicker_realisations' --max-worst 5"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
