@@ -87,23 +87,23 @@ def snapshot(fn, dp, deep, pool=None):
     extra = None
     if pool is not None:
         inside = in_pool(x[interior], pool)
-        extra = (float(np.mean(zero[inside])) if inside.any() else 0.0,
-                 int(zero.sum()), int((zero & ~inside).sum()),
-                 neighbour_pressure(x, p, fluid, interior, zero, dp, ~inside),
-                 neighbour_pressure(x, p, fluid, interior, zero, dp, inside), int(interior.size),
-                 dist[zero & ~inside], dist[zero & inside])
+        around = neighbour_pressure(x, p, fluid, interior[zero], dp)
+        extra = {'pool': float(np.mean(zero[inside])) if inside.any() else 0.0,
+                 'zero': int(zero.sum()), 'outside': int((zero & ~inside).sum()),
+                 'interior': int(interior.size),
+                 # for each zero: the fluid's mean pressure around it, its
+                 # distance to the surface (dp), whether it is in the pool
+                 'around': around, 'dist': dist[zero], 'in_pool': inside[zero]}
     return (t, float(zero.mean()), [float(np.mean(zero & b)) for b in bands],
             float(np.mean(areas)) if areas else float('nan'), extra)
 
 
-def neighbour_pressure(x, p, fluid, interior, zero, dp, mask):
-    """For each interior particle at P = 0 selected by mask (over interior):
-    the mean pressure of the fluid within 2.1 dp of it (Eq. 7's radius, the
-    particle itself left out; surface particles count, at their P = 0; walls
-    and solids do not). Near
-    0 where the particle sits in water at the air's pressure (a free jet),
-    large where it is a hole in loaded water."""
-    sel = interior[zero & mask]
+def neighbour_pressure(x, p, fluid, sel, dp):
+    """For each particle of sel (interior particles at P = 0): the mean
+    pressure of the fluid within 2.1 dp of it (Eq. 7's radius, the particle
+    itself left out; surface particles count, at their P = 0; walls and
+    solids do not). Near 0 where the particle sits in water at the air's
+    pressure (a free jet), large where it is a hole in loaded water."""
     if not sel.size:
         return np.zeros(0)
     idx = np.where(fluid)[0]
@@ -190,6 +190,7 @@ def main():
               'holes': 0, 'patches': 0}
     table = []
     p_out, p_in, d_loaded = [], [], []
+    head = a.rho * 9.81 * a.dp  # one particle's depth of water, Pa
     print('run, t (s): interior at P = 0 | of it: < 1.5 dp, 1.5-%g dp, > %g dp from the '
           'surface | deep cells\' mean area (dp^2)' % (a.deep, a.deep))
     for run in a.runs:
@@ -205,25 +206,25 @@ def main():
             rows.append([s[0], s[1]] + s[2] + [s[3]])
             tail = ''
             if s[4] is not None:
-                head = a.rho * 9.81 * a.dp
-                holes = np.sum(s[4][3] > head) + np.sum(s[4][4] > head)
+                e = s[4]
+                loaded = e['around'] > head
                 # a zero deep in the water is a hole even where its neighbours
                 # are zeros too (a patch at P = 0, not a jet's air pressure)
-                patch = (np.sum((s[4][3] > head) | (s[4][6] >= a.deep)) +
-                         np.sum((s[4][4] > head) | (s[4][7] >= a.deep)))
+                patch = loaded | (e['dist'] >= a.deep)
                 tail = ' | pool %5.1f%% | in loaded water %5.1f%% | or deep %5.1f%%' % (
-                    100 * s[4][0], 100.0 * holes / s[4][5], 100.0 * patch / s[4][5])
-                counts['patches'] += patch > 0.05 * s[4][5]
+                    100 * e['pool'], 100.0 * loaded.sum() / e['interior'],
+                    100.0 * patch.sum() / e['interior'])
                 counts['snapshots'] += 1
                 counts['all'] += s[1] > 0.05
                 counts['beyond'] += s[2][1] + s[2][2] > 0.05
-                counts['pool'] += s[4][0] > 0.05
-                counts['holes'] += holes > 0.05 * s[4][5]
-                counts['zero'] += s[4][1]
-                counts['outside'] += s[4][2]
-                p_out.append(s[4][3])
-                p_in.append(s[4][4])
-                d_loaded.append(np.concatenate([s[4][6][s[4][3] > head], s[4][7][s[4][4] > head]]))
+                counts['pool'] += e['pool'] > 0.05
+                counts['holes'] += loaded.sum() > 0.05 * e['interior']
+                counts['patches'] += patch.sum() > 0.05 * e['interior']
+                counts['zero'] += e['zero']
+                counts['outside'] += e['outside']
+                p_out.append(e['around'][~e['in_pool']])
+                p_in.append(e['around'][e['in_pool']])
+                d_loaded.append(e['dist'][loaded])
             print('%s %.4f: %5.1f%% | %5.1f%% %5.1f%% %5.1f%% | %.4f%s'
                   % (run, s[0], 100 * s[1], 100 * s[2][0], 100 * s[2][1], 100 * s[2][2], s[3],
                      tail))
@@ -242,7 +243,6 @@ def main():
               '%.1f%% outside the pool'
               % (c['snapshots'], c['all'], c['beyond'], c['pool'], c['zero'],
                  100.0 * c['outside'] / max(c['zero'], 1)))
-        head = a.rho * 9.81 * a.dp
         print('snapshots with over 5%% of the interior at P = 0 in loaded water (the fluid within '
               '2.1 dp above rho g dp on average), of %d: %d; counting also the zeros %g dp or '
               'more from the free surface: %d' % (c['snapshots'], c['holes'], a.deep,

@@ -21,7 +21,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, HERE)
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), 'tests', 'coupler'))
-from check_plate_flicker import force_series_smoothness, judged_rows, running_mean  # noqa: E402
+from check_plate_flicker import force_series_smoothness, judged_rows  # noqa: E402
 from probes_csv import probes_table  # noqa: E402
 
 
@@ -85,8 +85,8 @@ def plot(path, t, forces, mean, column):
     fig, axs = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True)
     for ax, fx, title in ((axs[0], forces[0], 'one realisation'),
                           (axs[1], mean, 'the mean of %d realisations' % len(forces))):
-        rm = running_mean(t, fx)
-        band = 0.15 * np.maximum(np.abs(rm), 0.1 * np.abs(fx).max())
+        _, rm, _, peak, _ = judged_rows(t, fx)
+        band = 0.15 * np.maximum(np.abs(rm), 0.1 * peak)
         ax.fill_between(t, rm - band, rm + band, color='0.85', label='20 ms mean +- 15%')
         ax.plot(t, fx, lw=0.7, color='tab:blue', label='2 ms rows')
         for x0, x1 in failing_intervals(t, fx):
