@@ -3,6 +3,7 @@
 flow's own (docs/pressure.md, "The decay of Eq. 23's reference step").
 
 usage: bench/plate_force_ensemble.py DIR [--column solid_fx] [--subsets] [--plot PNG]
+                                     [--rows T0 T1]
 
 DIR: the realisations of bench/flicker_ensemble.py --plate (DIR/1, DIR/2, ...).
 Prints the share of the 2 ms force rows within 15% of their 20 ms running mean
@@ -30,6 +31,8 @@ def main():
     ap.add_argument('dir')
     ap.add_argument('--column', default='solid_fx')
     ap.add_argument('--plot', metavar='PNG', help='draw one run\'s force and the mean (to 1.2 s)')
+    ap.add_argument('--rows', type=float, nargs=2, metavar=('T0', 'T1'),
+                    help='print the mean force\'s rows in T0-T1 s, those outside the band marked')
     ap.add_argument('--subsets', action='store_true',
                     help='the mean of the first 2, 4, 8, ... runs, and the deviation split into '
                     'what the runs share and what each has of its own')
@@ -57,6 +60,15 @@ def main():
               mean.min(), t[mean.argmin()]))
     print('its rows outside 15%%: %s' % (', '.join(
         '%.3f-%.3f s' % iv for iv in failing_intervals(t, mean)) or 'none'))
+    if a.rows:
+        m, _, ok, _, _ = judged_rows(t, mean)
+        bad = np.zeros(t.size, bool)
+        bad[np.where(m)[0][~ok]] = True
+        w = (t >= a.rows[0]) & (t <= a.rows[1])
+        for tt, fx, b in zip(t[w], mean[w], bad[w]):
+            print('  %.3f s  %8.1f N/m%s' % (tt, fx, '  outside' if b else ''))
+        print('rows of the mean in %.3f-%.3f s: %d judged, %d outside 15%%' % (
+            a.rows[0], a.rows[1], int((m & w).sum()), int((bad & w).sum())))
     if a.plot:
         plot(a.plot, t, forces, mean, a.column)
     if a.subsets:
