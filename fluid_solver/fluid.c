@@ -867,6 +867,7 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     f->step++;
     f->dt_last = dt;
     f->dt_kappa = f->last.dt_kappa;
+    f->dt_kappa_expansion = f->last.dt_kappa_expansion;
     guard_tank(f);
     st = remove_lost(f, err);
     if (!st)

@@ -44,6 +44,7 @@ struct fluid_step_stats {
     double dt;
     double dt_cfl;         /* the CFL step at the step's start (>= dt) */
     double dt_kappa;       /* the step Eq. 23's correction was scaled by (fluid_ppe.c) */
+    double dt_kappa_expansion; /* ... in the rows below n0 (>= dt_kappa) */
     int ppe_iterations;
     int ppe_rows;
     int rows_at_zero;      /* PPE rows whose pressure came out <= 0 (clamped) */
@@ -130,6 +131,7 @@ struct fluid {
     long step;
     double dt_last;
     double dt_kappa;           /* the last step's dt_kappa (fluid.kappa_step_decay) */
+    double dt_kappa_expansion; /* and its dt_kappa_expansion (..._decay_expansion) */
     long ppe_iterations;
     long nbr_rebuilds;
     /* Which build the lists nl and nl_tank hold: a fresh value at every

@@ -6,7 +6,7 @@
 /* The scalars, as one block (the order is the format). */
 struct fluid_scalars {
     uint64_t nfluid, nfixed_end;
-    double time, dt_last, dt_kappa, load_scale;
+    double time, dt_last, dt_kappa, dt_kappa_expansion, load_scale;
     int64_t step, lost, wall_guard, solid_placed;
 };
 
@@ -28,7 +28,7 @@ static enum mps_status put_lists(const struct fluid *f, struct mps_ckpt *c, stru
 static enum mps_status put_rest(const struct fluid *f, struct mps_ckpt *c, struct mps_err *err)
 {
     struct fluid_scalars sc = {f->nfluid, f->nfixed_end, f->time, f->dt_last, f->dt_kappa,
-                               f->load_scale,
+                               f->dt_kappa_expansion, f->load_scale,
                                f->step, f->lost, f->wall_guard, f->solid_placed};
     struct fluid_guard_log g = {{f->wall_guard_face[0], f->wall_guard_face[1],
                                  f->wall_guard_face[2], f->wall_guard_face[3]},
@@ -66,6 +66,7 @@ static enum mps_status get_rest(struct fluid *f, struct mps_ckpt *c, struct mps_
     f->time = sc.time;
     f->dt_last = sc.dt_last;
     f->dt_kappa = sc.dt_kappa;
+    f->dt_kappa_expansion = sc.dt_kappa_expansion;
     f->load_scale = sc.load_scale;
     f->step = (long)sc.step;
     f->lost = (long)sc.lost;

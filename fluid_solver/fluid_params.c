@@ -37,6 +37,15 @@ const struct mps_key_spec fluid_case_keys[] = {
      "over several steps instead of quadrupling its pressure at once (dtk = max(dt, "
      "decay x the previous step's dtk)); 0: dtk = dt, as printed; 0.95 (default): about "
      "14 steps to follow a halved step (the default since 2026-12-04, docs/pressure.md)"},
+    {"fluid.kappa_step_decay_expansion", MPS_KEY_DOUBLE, "0.99", 0, 1, MPS_KEY_HI_OPEN, NULL, "",
+     "the same decay for the rows whose particle number density is below n0 (expanded "
+     "water, where Eq. 23 pulls the pressure down): their reference step falls by at most "
+     "this factor per step and never below the compression rows' (fluid.kappa_step_decay). "
+     "A CFL step that falls 3.5 times in 5 ms otherwise lets Eq. 23's tension in expanded "
+     "deep water grow as 1/(dt dtk) until the clamp sets most of the pool to P = 0 for a "
+     "step; 0: the compression rows' step, as before 2026-12-06; 0.99 (default): about 70 "
+     "steps to follow a halved step (docs/pressure.md, \"Expanded water follows the step "
+     "more slowly\")"},
     {"fluid.density_dead_band", MPS_KEY_DOUBLE, "0.0005", 0, 0.05, 0, NULL, "n0",
      "Eq. 23's density error is corrected only beyond this fraction of n0, by its excess "
      "(a soft threshold): an error below it is the lattice's own noise, and correcting it "
@@ -319,6 +328,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->kappa = mps_case_double(c, "fluid.kappa");
     p->kappa_dt = mps_case_double(c, "fluid.kappa_dt");
     p->kappa_step_decay = mps_case_double(c, "fluid.kappa_step_decay");
+    p->kappa_step_decay_expansion = mps_case_double(c, "fluid.kappa_step_decay_expansion");
     p->density_dead_band = mps_case_double(c, "fluid.density_dead_band");
     p->density_quadratic = strcmp(mps_case_string(c, "fluid.density_weight"), "quadratic") == 0;
     p->alpha = mps_case_double(c, "fluid.alpha");

@@ -69,6 +69,7 @@ struct fluid_params {
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
     double kappa_dt;              /* s: steps shorter than this correct kappa dt / kappa_dt */
     double kappa_step_decay;      /* per step: how fast Eq. 23's reference step may fall */
+    double kappa_step_decay_expansion; /* the same, for the rows whose water has expanded */
     int density_quadratic;        /* Eq. 23's density error from mps_weight_quadratic */
     double density_dead_band;     /* n0: Eq. 23 corrects only the error beyond this */
     double re_n, re_lap;          /* effective radii, multiples of dp */

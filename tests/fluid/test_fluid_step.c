@@ -406,8 +406,36 @@ static void test_ppe_terms(void)
             worst = fmax(worst, fabs(f->rhs[f->row[i]] - p->kappa * p->rho / (dt * 4.0 * dt) *
                                                            (f->nd[i] - f->n0) / f->n0));
     CHECK(worst <= 1e-12 * big);
-    /* alpha on the diagonal */
+    /* fluid.kappa_step_decay and ..._expansion: after the step fell, the
+     * reference step of the compressed rows (n >= n0) falls by at most
+     * kappa_step_decay a step, that of the expanded rows (n < n0) by at most
+     * kappa_step_decay_expansion and never below the other */
     f->prm.kappa_dt = 0.0;
+    f->dt_kappa = 2.0 * dt;
+    f->dt_kappa_expansion = 4.0 * dt;
+    CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
+    const double dtk = p->kappa_step_decay * 2.0 * dt;
+    const double dtk_e = fmax(dtk, p->kappa_step_decay_expansion * 4.0 * dt);
+    CHECK(dtk > dt && dtk_e > dtk);
+    worst = 0.0;
+    int expanded = 0, compressed = 0;
+    for (size_t i = 0; i < f->ps.n; i++) {
+        if (f->row[i] < 0)
+            continue;
+        double dn = f->nd[i] - f->n0;
+        double want = p->kappa * p->rho / (dt * (dn < 0.0 ? dtk_e : dtk)) * dn / f->n0;
+        worst = fmax(worst, fabs(f->rhs[f->row[i]] - want));
+        expanded += dn < 0.0;
+        compressed += dn > 0.0;
+    }
+    printf("PPE source after the step fell: %d expanded rows at kappa rho / (dt %.4g dt), %d "
+           "compressed at / (dt %.4g dt), worst %.3g\n",
+           expanded, dtk_e / dt, compressed, dtk / dt, worst);
+    CHECK(expanded > 0 && compressed > 0 && worst <= 1e-12 * big);
+    CHECK_NEAR(f->last.dt_kappa, dtk, 1e-15);
+    CHECK_NEAR(f->last.dt_kappa_expansion, dtk_e, 1e-15);
+    f->dt_kappa = f->dt_kappa_expansion = 0.0;
+    /* alpha on the diagonal */
     const double alpha = f->prm.alpha;
     f->prm.alpha = 0.0;
     CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);

@@ -93,20 +93,21 @@ add_test(NAME fluid_pressure_flicker_steps
           -- ${FV_SOLVER} cases/dambreak/case.yml --set dp=0.008 --set end_time=0.3
              --set output.interval=0 --set fluid.step_log=true
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-# fluid_dambreak_flicker_realisations: the issue's target on the 4 mm dam
-# break to 0.3 s (snapshots every 0.02 s), in each of 8 jittered realisations
-# (bench/flicker_ensemble.py, one thread): no snapshot after 0.05 s with more
-# than 5% of the interior fluid at P = 0. Measured (2026-12-04) with the
-# defaults (walls slipping in Eq. 10, fluid.kappa_step_decay 0.95): worst
-# 1.95-3.52%; without the decay 4 of 8 over (41-63% at the impact on the
-# right wall, where the CFL step drops); with the walls fixed 2.9 snapshots
-# over per realisation. The band is the target itself: 5% is 1.5 points above
-# the worst realisation, and one impact step that goes wrong reads 40-60%.
-# Seeds 1-8 are a good draw for the defaults: over seeds 1-32 (2026-12-06) 13
-# of 32 realisations have a snapshot over 5% (docs/pressure.md, "What a run
-# without noise could reach"), so this guards a regression, not the target.
+# fluid_dambreak_flicker_realisations: the 4 mm dam break to 0.3 s (snapshots
+# every 0.02 s) in 16 jittered realisations (bench/flicker_ensemble.py, one
+# thread): no snapshot after 0.05 s with more than 12% of the interior fluid at
+# P = 0. The issue's target is 5%, and neither these defaults nor the ones
+# before meet it over many seeds (docs/pressure.md, "Expanded water follows the
+# step more slowly"). Measured (2026-12-06) over seeds 1-32: with
+# fluid.kappa_step_decay_expansion 0.99 (the default) 4 of 32 realisations have
+# a snapshot over 5%, at 5.7-8.8%, none over 10%; with it off (0) 13 of 32, 7
+# of them at 13.7-49.9% (seed 12's 49.9% is most of the pool at P = 0 for a
+# step); seeds 1-16 alone: 3 at 8.1-8.8% against 4 at 6.8-49.9%. The band sits
+# between the two: 3 points above the worst with the default, 1.7 below the
+# smallest of the seven. Seeds 1-8 (this test's seeds before) were a good draw
+# for the setting off: none over 5% there.
 add_test(NAME fluid_dambreak_flicker_realisations
-  COMMAND sh -c "rm -rf '${FV_OUT}/flicker_realisations' && /usr/bin/python3 bench/flicker_ensemble.py --build '${CMAKE_BINARY_DIR}' --runs 8 --out '${FV_OUT}/flicker_realisations' --max-worst 5"
+  COMMAND sh -c "rm -rf '${FV_OUT}/flicker_realisations' && /usr/bin/python3 bench/flicker_ensemble.py --build '${CMAKE_BINARY_DIR}' --runs 16 --out '${FV_OUT}/flicker_realisations' --max-worst 12"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # fluid_pressure_flicker_laplacian: the option pair of docs/pressure.md, "The
 # divergence on the Laplacian's stencil" (fluid.divergence_stencil =
