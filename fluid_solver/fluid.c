@@ -240,6 +240,7 @@ void fluid_destroy(struct fluid **pf)
     free(f->val);
     free(f->rhs);
     free(f->sol);
+    free(f->ppe_terms);
     fluid_linsolve_destroy(&f->ls);
     fluid_sensors_destroy(&f->sens);
     free(f);

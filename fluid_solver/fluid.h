@@ -125,6 +125,12 @@ struct fluid {
     int *rowptr, *col;
     double *val, *rhs, *sol;
     size_t cap_rows, cap_nnz;
+    /* with keep_ppe_terms (fluid_solver --dump-ppe): per row, the row
+     * particle's position at the assembly and the rhs's parts, each a
+     * FLUID_PPE_TERMS-wide record (fluid_ppe.h) */
+    int keep_ppe_terms;
+    double *ppe_terms;
+    size_t cap_ppe_terms;
     struct fluid_linsolve *ls;
     /* bookkeeping */
     double time;

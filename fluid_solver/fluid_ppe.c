@@ -268,6 +268,13 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         grow((void **)&f->sol, &rcap3, (size_t)nrows + 1, sizeof(double)))
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %d rows", nrows);
     f->cap_rows = rcap < rcap2 ? (rcap < rcap3 ? rcap : rcap3) : (rcap2 < rcap3 ? rcap2 : rcap3);
+    double *terms = NULL;
+    if (f->keep_ppe_terms) {
+        if (grow((void **)&f->ppe_terms, &f->cap_ppe_terms, ((size_t)nrows + 1) * FLUID_PPE_TERMS,
+                 sizeof(double)))
+            return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %d rows' terms", nrows);
+        terms = f->ppe_terms;
+    }
 
     const double c = 2.0 * MPS_DIM / (f->lambda_lap * f->n0_lap);
     /* The first step has no earlier pressure that belongs to the flow (the
@@ -409,12 +416,26 @@ enum mps_status fluid_ppe_assemble(struct fluid *f, double dt, struct mps_err *e
         /* Eq. 23's density term, its error relative to n0 either way */
         double dn = p->density_quadratic ? f->n0 * (f->nq[i] / f->nq0 - 1.0) : f->nd[i] - f->n0;
         dn = dead_band(dn, band);
-        f->rhs[r] = ghost + (dn < 0.0 ? src_expansion : src) * dn;
+        const double density = (dn < 0.0 ? src_expansion : src) * dn;
+        f->rhs[r] = ghost + density;
         if (div_wide || body)
             f->div[i] = div_norm * row_divergence_sum(f, i);
-        if (mixed) /* with Neumann walls compressibility acts on the change of
-                    * pressure, see fluid_ppe.h */
-            f->rhs[r] += (ghosts ? comp * f->p[i] : 0.0) - f->div[i] * div_coef;
+        double memory = 0.0, divergence = 0.0;
+        if (mixed) { /* with Neumann walls compressibility acts on the change of
+                      * pressure, see fluid_ppe.h */
+            memory = ghosts ? comp * f->p[i] : 0.0;
+            divergence = -f->div[i] * div_coef;
+            f->rhs[r] += memory + divergence;
+        }
+        if (terms) {
+            double *rec = terms + (size_t)r * FLUID_PPE_TERMS;
+            for (int d = 0; d < MPS_DIM; d++)
+                rec[d] = f->x[i][d];
+            rec[MPS_DIM] = ghost;
+            rec[MPS_DIM + 1] = density;
+            rec[MPS_DIM + 2] = memory;
+            rec[MPS_DIM + 3] = divergence;
+        }
         f->sol[r] = f->p[i]; /* warm start */
     }
     return MPS_OK;
@@ -578,7 +599,8 @@ void fluid_ppe_boundary_clamp(struct fluid *f)
 }
 
 enum mps_status fluid_ppe_dump(const struct fluid *f, const char *matrix_path,
-                               const char *rhs_path, struct mps_err *err)
+                               const char *rhs_path, const char *terms_path,
+                               struct mps_err *err)
 {
     FILE *m = fopen(matrix_path, "w");
     if (!m)
@@ -602,5 +624,23 @@ enum mps_status fluid_ppe_dump(const struct fluid *f, const char *matrix_path,
         fprintf(b, "%.17g\n", f->rhs[r]);
     if (fclose(b))
         return mps_err_set(err, MPS_EIO, "%s: cannot write", rhs_path);
+    if (!terms_path || !f->ppe_terms)
+        return MPS_OK;
+    FILE *t = fopen(terms_path, "w");
+    if (!t)
+        return mps_err_set(err, MPS_EIO, "%s: cannot write", terms_path);
+    fprintf(t, "# the rhs of each PPE row (ppe_b.mtx) in its parts, which sum to it; "
+               "x at the assembly (m), parts in the rhs's units\n");
+    fprintf(t, MPS_DIM == 2 ? "row,x,y,ghost,density,compressibility,divergence\n"
+                            : "row,x,y,z,ghost,density,compressibility,divergence\n");
+    for (int r = 0; r < f->nrows; r++) {
+        const double *q = f->ppe_terms + (size_t)r * FLUID_PPE_TERMS;
+        fprintf(t, "%d", r + 1);
+        for (int k = 0; k < FLUID_PPE_TERMS; k++)
+            fprintf(t, ",%.17g", q[k]);
+        fputc('\n', t);
+    }
+    if (fclose(t))
+        return mps_err_set(err, MPS_EIO, "%s: cannot write", terms_path);
     return MPS_OK;
 }

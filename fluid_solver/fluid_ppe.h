@@ -41,9 +41,20 @@ void fluid_ppe_boundary_pressure(struct fluid *f);
  * the gradient has used them: for output and the loads on a solid. */
 void fluid_ppe_boundary_clamp(struct fluid *f);
 
+/* The rhs of a PPE row is the sum of four parts, kept per row when
+ * f->keep_ppe_terms is set: the walls' hydrostatic extrapolation (ghost),
+ * Eq. 23's density error, the compressibility's memory of the last
+ * pressure, and the mixed source's divergence. The PPE is linear, so the
+ * pressure is the sum of the pressures each part alone asks for
+ * (bench/ppe_terms.py; docs/pressure.md, "The two halves of the mixed
+ * source"). A record is the row particle's position, then the four. */
+enum { FLUID_PPE_TERMS = MPS_DIM + 4 };
+
 /* Writes the last assembled system as Matrix Market files (A: lower triangle,
- * b: array), for the solver benchmarks. */
+ * b: array), for the solver benchmarks; with terms_path (and
+ * f->keep_ppe_terms) also the rhs's parts per row as CSV. */
 enum mps_status fluid_ppe_dump(const struct fluid *f, const char *matrix_path,
-                               const char *rhs_path, struct mps_err *err);
+                               const char *rhs_path, const char *terms_path,
+                               struct mps_err *err);
 
 #endif

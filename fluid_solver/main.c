@@ -535,7 +535,7 @@ int main(int argc, char **argv)
 
     struct mps_cli cli;
     struct mps_cli_extra extra[] = {
-        {"--dump-ppe", 1, "write the PPE of step N as Matrix Market files into --out", NULL},
+        {"--dump-ppe", 1, "write the PPE of step N as Matrix Market files, and its rhs's parts as ppe_terms.csv, into --out", NULL},
     };
     const char *usage = "usage: fluid_solver CASE.yml --out DIR [--set key=value]... [--quiet]\n"
                         "       fluid_solver --connect ENDPOINT [--timeout S]   (under the coupler)";
@@ -561,13 +561,15 @@ int main(int argc, char **argv)
         if (extra[0].value) {
             /* benchmark aid: run to step N and dump its PPE */
             long target = atol(extra[0].value);
+            r.f->keep_ppe_terms = 1;
             while (!st && r.f->step < target)
                 st = fluid_step(r.f, fluid_cfl_dt(r.f), &err);
-            char mpath[4200], bpath[4200];
+            char mpath[4200], bpath[4200], tpath[4200];
             snprintf(mpath, sizeof mpath, "%s/ppe_A.mtx", r.out);
             snprintf(bpath, sizeof bpath, "%s/ppe_b.mtx", r.out);
+            snprintf(tpath, sizeof tpath, "%s/ppe_terms.csv", r.out);
             if (!st)
-                st = fluid_ppe_dump(r.f, mpath, bpath, &err);
+                st = fluid_ppe_dump(r.f, mpath, bpath, tpath, &err);
         } else {
             st = run_standalone(&r, &err);
         }

@@ -81,6 +81,16 @@ add_test(NAME fluid_ppe_scaling
 add_test(NAME fluid_pressure_flicker
   COMMAND sh ${FV_DIR}/scripts/flicker.sh ${FV_SOLVER} ${FV_OUT}/flicker
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# fluid_ppe_terms: fluid_solver --dump-ppe's record of the PPE rhs's four
+# parts and bench/ppe_terms.py's pressure of each: in still water they sum to
+# the hydrostatic pressure and the density and divergence parts are small; on
+# the 8 mm dam break the record reproduces the step log's count at P <= 0
+# (the bands and their reasons in the script; docs/pressure.md, "The two
+# halves of the mixed source").
+add_test(NAME fluid_ppe_terms
+  COMMAND /usr/bin/python3 ${FV_DIR}/test_ppe_terms.py ${FV_SOLVER} ${FV_OUT}/ppe_terms
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_ppe_terms PROPERTIES TIMEOUT 120)
 # fluid_pressure_flicker_steps: the defaults (the tank's walls slipping in
 # Eq. 10, fluid.divergence_walls = slip, docs/pressure.md, "Walls that slip
 # in Eq. 10") on the 8 mm dam break to 0.3 s: the PPE rows at P <= 0 per step
