@@ -551,6 +551,16 @@ int main(int argc, char **argv)
         fprintf(stderr, "fluid_solver: missing --out DIR (see --help)\n");
         return 2;
     }
+    long target = 0; /* --dump-ppe N */
+    if (extra[0].value) {
+        char *end = NULL;
+        target = strtol(extra[0].value, &end, 10);
+        if (end == extra[0].value || *end || target < 1) {
+            fprintf(stderr, "fluid_solver: --dump-ppe '%s': not a step number (a whole number "
+                            ">= 1: the step of that row of fluid_steps.csv)\n", extra[0].value);
+            return 2;
+        }
+    }
     struct run r = {.out = cli.out_dir, .quiet = cli.quiet, .summary_name = "summary.json",
                     .prefix = "fluid",
                     .stop_at = cli.stop_at};
@@ -560,7 +570,6 @@ int main(int argc, char **argv)
     if (st == MPS_OK) {
         if (extra[0].value) {
             /* benchmark aid: run to step N and dump its PPE */
-            long target = atol(extra[0].value);
             r.f->keep_ppe_terms = 1;
             while (!st && r.f->step < target)
                 st = fluid_step(r.f, fluid_cfl_dt(r.f), &err);

@@ -26,6 +26,10 @@ fluid_expect_fail(fluid_bad_coarse_cell "fluid.ppe_coarse_cell = 0.5: must be in
                   ${FS} ${DB} ${OUT} --set fluid.ppe_coarse_cell=0.5)
 fluid_expect_fail(fluid_bad_unknown_key_in_file "tests/fluid/bad_key.yml:6: fluid.bogus = 1: unknown key"
                   ${FS} tests/fluid/bad_key.yml ${OUT})
+# --dump-ppe N (the PPE of the N-th step, docs/output.md): a step number or nothing;
+# it read 'abc' as step 0 and wrote an empty system, exit 0
+fluid_expect_fail(fluid_bad_dump_ppe_step "--dump-ppe '12x': not a step number"
+                  ${FS} ${DB} ${OUT} --dump-ppe 12x)
 fluid_expect_fail(coupler_bad_negative_dp "coupler: .*dp = -0.004: must be > 0"
                   ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set dp=-0.004)
 fluid_expect_fail(coupler_bad_no_scene "neither a fluid .* nor a solid"
