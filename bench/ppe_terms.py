@@ -29,6 +29,8 @@ import numpy as np
 import scipy.io
 import scipy.sparse.linalg
 
+from probes_csv import probes_table
+
 PARTS = ("ghost", "density", "compressibility", "divergence")
 
 
@@ -36,18 +38,14 @@ def read_dir(d):
     """(A as CSC, b, positions, parts as columns) of one dump."""
     A = scipy.io.mmread(os.path.join(d, "ppe_A.mtx")).tocsc()
     b = np.asarray(scipy.io.mmread(os.path.join(d, "ppe_b.mtx"))).ravel()
-    with open(os.path.join(d, "ppe_terms.csv")) as fh:
-        lines = [ln for ln in fh if not ln.startswith("#")]
-    head = lines[0].strip().split(",")
-    rows = np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
-    if rows.shape[0] != b.size:
-        raise ValueError(f"ppe_terms.csv has {rows.shape[0]} rows, ppe_b.mtx {b.size}")
-    cols = {name: k for k, name in enumerate(head)}
-    missing = [p for p in PARTS + ("x", "y") if p not in cols]
+    rows = probes_table(os.path.join(d, "ppe_terms.csv"))
+    if rows.size != b.size:
+        raise ValueError(f"ppe_terms.csv has {rows.size} rows, ppe_b.mtx {b.size}")
+    missing = [p for p in PARTS + ("x", "y") if p not in rows.dtype.names]
     if missing:
         raise ValueError(f"ppe_terms.csv: no column {', '.join(missing)}")
-    parts = np.column_stack([rows[:, cols[p]] for p in PARTS])
-    xy = np.column_stack([rows[:, cols["x"]], rows[:, cols["y"]]])
+    parts = np.column_stack([rows[p] for p in PARTS])
+    xy = np.column_stack([rows["x"], rows["y"]])
     return A, b, xy, parts
 
 

@@ -31,6 +31,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'bench'))
 import ppe_terms  # noqa: E402
+from probes_csv import probes_table  # noqa: E402
 
 RHO, G, H_LINE = 1000.0, 9.81, 0.295
 
@@ -73,11 +74,8 @@ def dambreak(solver, out, fails):
     if run([solver] + case + ['--set', 'fluid.step_log=true', '--out', log_dir, '--quiet']):
         fails.append('dam break: fluid_solver failed')
         return
-    with open(os.path.join(log_dir, 'fluid_steps.csv')) as fh:
-        lines = [ln for ln in fh if not ln.startswith('#')]
-    head = lines[0].strip().split(',')
-    log = np.array([[float(v) for v in ln.split(',')] for ln in lines[1:]])
-    t, zero, rows = (log[:, head.index(c)] for c in ('time', 'rows_at_zero', 'ppe_rows'))
+    log = probes_table(os.path.join(log_dir, 'fluid_steps.csv'))
+    t, zero, rows = (log[c] for c in ('time', 'rows_at_zero', 'ppe_rows'))
     late = np.where(t > 0.05)[0]
     k = int(late[np.argmax(zero[late])])
     step = k + 1  # the log's k-th row (from 0) is the step that ends the (k+1)-th
