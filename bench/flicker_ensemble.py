@@ -4,7 +4,7 @@ divergence on the Laplacian's stencil").
 
 usage: bench/flicker_ensemble.py [--build build] [--runs 8] [--plate]
                                  [--out DIR] [--set KEY=VALUE ...]
-                                 [--max-worst PERCENT]
+                                 [--max-worst PERCENT [--allow N]]
 
 Runs `--runs` realisations (fluid.jitter, amplitude 1e-3 dp, seeds 1..N, one
 thread each) of
@@ -27,7 +27,9 @@ Runs already in OUT (a summary.json) are reused. --set goes to every run.
 --max-worst (the dam break; ctest fluid_dambreak_flicker_realisations): exit 1
 if any realisation has a snapshot after 0.05 s with more than PERCENT of its
 interior fluid at P = 0 (the issue's target is 5), each realisation's worst
-snapshot printed."""
+snapshot printed; with --allow N, only if more than N realisations have one
+(a count over an ensemble, for a band that a rare event in one draw may pass:
+docs/pressure.md, "Water that holds no tension")."""
 import argparse, glob, json, os, subprocess, sys, tempfile
 
 import numpy as np
@@ -94,9 +96,12 @@ def main():
     ap.add_argument('--out')
     ap.add_argument('--set', action='append', default=[], metavar='KEY=VALUE')
     ap.add_argument('--max-worst', type=float, metavar='PERCENT')
+    ap.add_argument('--allow', type=int, default=0, metavar='N')
     a = ap.parse_args()
     if a.max_worst is not None and a.plate:
         ap.error('--max-worst is for the dam break')
+    if a.allow < 0 or (a.allow and a.max_worst is None):
+        ap.error('--allow N: a count >= 0, with --max-worst')
     out = a.out or tempfile.mkdtemp(prefix='flicker_ensemble_')
     sets = [x for kv in a.set for x in ('--set', kv)]
     one = plate if a.plate else dambreak
@@ -117,11 +122,13 @@ def main():
     print('| ' + ' | '.join('%.3g +- %.2g' % (m, s) for m, s in zip(mean, se)) + ' |')
     if a.max_worst is not None:
         worst = rows[:, names.index('worst snapshot %')]
-        print('worst snapshot after 0.05 s per realisation (%%): %s; band %.3g%%' % (
-            ' '.join('%.2f' % w for w in worst), a.max_worst))
-        if worst.max() > a.max_worst:
+        over = int((worst > a.max_worst).sum())
+        print('worst snapshot after 0.05 s per realisation (%%): %s; band %.3g%%, %d of %d '
+              'realisations over it (at most %d allowed)' % (
+                  ' '.join('%.2f' % w for w in worst), a.max_worst, over, len(worst), a.allow))
+        if over > a.allow:
             print('FAIL: %d of %d realisations have a snapshot over %.3g%%' % (
-                int((worst > a.max_worst).sum()), len(worst), a.max_worst))
+                over, len(worst), a.max_worst))
             sys.exit(1)
 
 

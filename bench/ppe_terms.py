@@ -16,7 +16,12 @@ P <= 0 and (--box) over the rows in a box of the plane, the mean of each
 part's pressure and of their sum, in Pa. A zero where the density part is
 strongly negative and the divergence part strongly positive is a place
 where the two halves of the mixed source nearly cancel; a step-to-step swing
-of either then moves the sum across zero.
+of either then moves the sum across zero. It also prints how many rows the
+same system leaves at P <= 0 when the water holds no tension (the
+complementarity problem fluid.tension_solves solves, here with direct
+solves; docs/pressure.md, "Water that holds no tension"), and with --json,
+where the record has the solver's `pressure` column, how far that is from
+this solution.
 
 Exit 1 if a file is missing or unreadable, or if the parts do not add up to
 ppe_b.mtx (relative 1e-9): the dump would not be the system that was solved."""
@@ -38,7 +43,7 @@ def read_dir(d):
     """(A as CSC, b, positions, parts as columns) of one dump."""
     A = scipy.io.mmread(os.path.join(d, "ppe_A.mtx")).tocsc()
     b = np.asarray(scipy.io.mmread(os.path.join(d, "ppe_b.mtx"))).ravel()
-    rows = probes_table(os.path.join(d, "ppe_terms.csv"))
+    rows = rows_of(d)
     if rows.size != b.size:
         raise ValueError(f"ppe_terms.csv has {rows.size} rows, ppe_b.mtx {b.size}")
     missing = [p for p in PARTS + ("x", "y") if p not in rows.dtype.names]
@@ -49,6 +54,10 @@ def read_dir(d):
     return A, b, xy, parts
 
 
+def rows_of(d):
+    return probes_table(os.path.join(d, "ppe_terms.csv"))
+
+
 def decompose(A, b, parts):
     """The pressure each part asks for (columns), and the mismatch of the
     parts' sum against b relative to b's size."""
@@ -57,6 +66,33 @@ def decompose(A, b, parts):
     lu = scipy.sparse.linalg.splu(A)
     P = np.column_stack([lu.solve(parts[:, k]) for k in range(parts.shape[1])])
     return P, mismatch
+
+
+def complementarity(A, b, max_solves=50):
+    """The pressure with no tension, as fluid.tension_solves computes it but
+    with direct solves: P >= 0, A P = b where P > 0, A P - b >= 0 where P = 0
+    (the water there may only expand). A primal-dual active set: hold the
+    rows that come out negative at 0, let go the held rows whose equation
+    asks for a pressure, until the set settles. Every row may be held: the
+    dumps this reads have fluid rows only (walls and solids as ghosts).
+    Returns (P, solves after the first); None for P if it did not settle."""
+    n = b.size
+    A = A.tocsr()
+    P = scipy.sparse.linalg.splu(A.tocsc()).solve(b)
+    held = P < 0.0
+    if not held.any():
+        return P, 0
+    for solves in range(1, max_solves + 1):
+        free = ~held
+        P = np.zeros(n)
+        if free.any():
+            P[free] = scipy.sparse.linalg.splu(A[free][:, free].tocsc()).solve(b[free])
+        w = A @ P - b
+        new = np.where(held, w >= 0.0, P < 0.0)
+        if (new == held).all():
+            return P, solves
+        held = new
+    return None, max_solves
 
 
 def means(P, mask):
@@ -95,8 +131,17 @@ def main():
         zero = total <= 0.0
         rec = {"rows": int(b.size), "at_zero": int(zero.sum()),
                "all": means(P, np.ones(b.size, bool)), "zero": means(P, zero)}
+        released, solves = complementarity(A, b)
+        if released is not None:
+            rec["released_at_zero"] = int((released <= 0.0).sum())
+            rec["released_solves"] = solves
+            if "pressure" in rows_of(d).dtype.names:
+                rec["pressure_vs_released"] = float(
+                    np.abs(rows_of(d)["pressure"] - released).max())
         print(f"{d}: {b.size} rows, {zero.sum()} at P <= 0 ({100.0 * zero.mean():.1f}%); "
-              "mean pressure of each part of the source:")
+              + (f"with no tension {rec['released_at_zero']} ({solves} more solves); "
+                 if released is not None else "no tension: did not settle; ")
+              + "mean pressure of each part of the source:")
         print(line("all rows", rec["all"]))
         print(line("rows at P <= 0", rec["zero"]))
         if a.box:

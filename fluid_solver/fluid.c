@@ -241,6 +241,11 @@ void fluid_destroy(struct fluid **pf)
     free(f->rhs);
     free(f->sol);
     free(f->ppe_terms);
+    free(f->val_assembled);
+    free(f->rhs_assembled);
+    free(f->row_is_fluid);
+    free(f->row_held);
+    free(f->row_held_next);
     fluid_linsolve_destroy(&f->ls);
     fluid_sensors_destroy(&f->sens);
     free(f);

@@ -47,7 +47,8 @@ struct fluid_step_stats {
     double dt_kappa_expansion; /* ... in the rows below n0 (>= dt_kappa) */
     int ppe_iterations;
     int ppe_rows;
-    int rows_at_zero;      /* PPE rows whose pressure came out <= 0 (clamped) */
+    int rows_at_zero;      /* PPE rows whose pressure came out <= 0 (released or clamped) */
+    int tension_solves;    /* PPE solves after the first (fluid.tension_solves) */
     long collisions;       /* pair impulses of the collision model */
     int neighbour_build;   /* 1 if the neighbour list was rebuilt */
 };
@@ -128,6 +129,12 @@ struct fluid {
     /* with keep_ppe_terms (fluid_solver --dump-ppe): per row, the row
      * particle's position at the assembly and the rhs's parts, each a
      * FLUID_PPE_TERMS-wide record (fluid_ppe.h) */
+    /* fluid.tension_solves: the assembled system, kept while rows are
+     * released (the solves change val and rhs), and per row 1 if it is
+     * fluid, held at P = 0 now, next (fluid_ppe.c) */
+    double *val_assembled, *rhs_assembled;
+    unsigned char *row_is_fluid, *row_held, *row_held_next;
+    size_t cap_held_rows, cap_held_nnz;
     int keep_ppe_terms;
     double *ppe_terms;
     size_t cap_ppe_terms;

@@ -3,6 +3,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include "fluid_shadow.h"
 #include "mps_kernel.h"
@@ -517,6 +518,106 @@ static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err
     return MPS_OK;
 }
 
+/* Water holds no tension (fluid.tension_solves). Clamping the solution
+ * after one solve leaves each row next to a negative one with the pressure
+ * computed against that negative value, too low: in the 4 mm dam break's
+ * thin water behind the front half of it then went to P = 0 for a step
+ * whenever the divergence part of the source dipped (docs/pressure.md,
+ * "The two halves of the mixed source"). Here the fluid rows are split
+ * into those held at P = 0 (the water there may expand: A P - b >= 0) and
+ * the rest (A P = b, P >= 0), a linear complementarity problem; A is an
+ * M-matrix, for which the primal-dual active set below (hold the rows
+ * that came out negative, let go the held ones whose equation asks for a
+ * pressure, solve again) settles in a few solves. The held rows are
+ * decoupled, not removed, so the matrix keeps its pattern and rows. */
+static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_stats *stats,
+                                       struct mps_err *err)
+{
+    const int nr = f->nrows;
+    const size_t nnz = (size_t)f->rowptr[nr];
+    if (grow((void **)&f->val_assembled, &f->cap_held_nnz, nnz + 1, sizeof(double)))
+        return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %zu nonzeros", nnz);
+    size_t c1 = f->cap_held_rows, c2 = f->cap_held_rows, c3 = f->cap_held_rows,
+           c4 = f->cap_held_rows;
+    if (grow((void **)&f->rhs_assembled, &c1, (size_t)nr + 1, sizeof(double)) ||
+        grow((void **)&f->row_is_fluid, &c2, (size_t)nr + 1, 1) ||
+        grow((void **)&f->row_held, &c3, (size_t)nr + 1, 1) ||
+        grow((void **)&f->row_held_next, &c4, (size_t)nr + 1, 1))
+        return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %d rows", nr);
+    f->cap_held_rows = c1 < c2 ? c1 : c2;
+    f->cap_held_rows = f->cap_held_rows < c3 ? f->cap_held_rows : c3;
+    f->cap_held_rows = f->cap_held_rows < c4 ? f->cap_held_rows : c4;
+    unsigned char *is_fluid = f->row_is_fluid, *held = f->row_held, *next = f->row_held_next;
+    double *val0 = f->val_assembled, *rhs0 = f->rhs_assembled;
+    for (size_t i = 0; i < f->ps.n; i++)
+        if (f->row[i] >= 0)
+            is_fluid[f->row[i]] = f->is_fluid[i];
+    int nheld = 0;
+    for (int r = 0; r < nr; r++) {
+        held[r] = is_fluid[r] && f->sol[r] < 0.0;
+        nheld += held[r];
+    }
+    if (nheld == 0)
+        return MPS_OK;
+    memcpy(val0, f->val, nnz * sizeof(double));
+    memcpy(rhs0, f->rhs, (size_t)nr * sizeof(double));
+    struct fluid_csr A = {nr, f->rowptr, f->col, f->val};
+    enum mps_status st = MPS_OK;
+    int solves = 0, changed = 1;
+    while (changed && solves < f->prm.tension_solves) {
+        /* a held row keeps its diagonal and rhs 0, so its solution is 0 */
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < nr; r++) {
+            f->rhs[r] = held[r] ? 0.0 : rhs0[r];
+            for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++) {
+                int q = f->col[k];
+                f->val[k] = (q != r && (held[r] || held[q])) ? 0.0 : val0[k];
+            }
+            if (held[r])
+                f->sol[r] = 0.0;
+        }
+        struct fluid_linsolve_stats ls;
+        st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, &ls, err);
+        if (st) {
+            mps_err_prefix(err, "PPE at t = %.6g s, solve %d with %d rows under tension held "
+                                "at P = 0: ", f->time, solves + 2, nheld);
+            break;
+        }
+        stats->iterations += ls.iterations;
+        solves++;
+        /* exactly 0: pcg_defl's coarse correction leaves a round-off there */
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < nr; r++)
+            if (held[r])
+                f->sol[r] = 0.0;
+        changed = 0;
+        nheld = 0;
+#pragma omp parallel for schedule(static) reduction(| : changed) reduction(+ : nheld)
+        for (int r = 0; r < nr; r++) {
+            if (held[r]) { /* let go if its equation asks for a pressure */
+                double w = -rhs0[r];
+                for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++)
+                    w += val0[k] * f->sol[f->col[k]];
+                next[r] = w >= 0.0;
+            } else {
+                next[r] = is_fluid[r] && f->sol[r] < 0.0;
+            }
+            changed |= next[r] != held[r];
+            nheld += next[r];
+        }
+        unsigned char *t = held;
+        held = next;
+        next = t;
+    }
+    f->row_held = held;
+    f->row_held_next = next;
+    f->last.tension_solves = solves;
+    /* the system as assembled, as --dump-ppe writes it */
+    memcpy(f->val, val0, nnz * sizeof(double));
+    memcpy(f->rhs, rhs0, (size_t)nr * sizeof(double));
+    return st;
+}
+
 enum mps_status fluid_ppe_solve(struct fluid *f, struct fluid_linsolve_stats *stats,
                                 struct mps_err *err)
 {
@@ -534,6 +635,8 @@ enum mps_status fluid_ppe_solve(struct fluid *f, struct fluid_linsolve_stats *st
         st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, stats, err);
         if (st)
             return mps_err_prefix(err, "PPE at t = %.6g s (%d unknowns): ", f->time, f->nrows);
+        if (f->prm.tension_solves > 0 && (st = release_tension(f, stats, err)))
+            return st;
     } else {
         *stats = (struct fluid_linsolve_stats){0};
     }
@@ -630,15 +733,17 @@ enum mps_status fluid_ppe_dump(const struct fluid *f, const char *matrix_path,
     if (!t)
         return mps_err_set(err, MPS_EIO, "%s: cannot write", terms_path);
     fprintf(t, "# the rhs of each PPE row (ppe_b.mtx) in its parts, which sum to it; "
-               "x at the assembly (m), parts in the rhs's units\n");
-    fprintf(t, MPS_DIM == 2 ? "row,x,y,ghost,density,compressibility,divergence\n"
-                            : "row,x,y,z,ghost,density,compressibility,divergence\n");
+               "x at the assembly (m), parts in the rhs's units; pressure: the step's "
+               "solution (Pa), before the clamp, the rows under tension held at 0 "
+               "(fluid.tension_solves)\n");
+    fprintf(t, MPS_DIM == 2 ? "row,x,y,ghost,density,compressibility,divergence,pressure\n"
+                            : "row,x,y,z,ghost,density,compressibility,divergence,pressure\n");
     for (int r = 0; r < f->nrows; r++) {
         const double *q = f->ppe_terms + (size_t)r * FLUID_PPE_TERMS;
         fprintf(t, "%d", r + 1);
         for (int k = 0; k < FLUID_PPE_TERMS; k++)
             fprintf(t, ",%.17g", q[k]);
-        fputc('\n', t);
+        fprintf(t, ",%.17g\n", f->sol[r]);
     }
     if (fclose(t))
         return mps_err_set(err, MPS_EIO, "%s: cannot write", terms_path);

@@ -97,14 +97,18 @@ static enum mps_status write_probes(struct run *r, struct mps_err *err)
     return mps_probes_write(r->probes, r->f->time, v, err);
 }
 
+/* The step log's columns after the time (fluid.step_log, docs/output.md). */
+enum { STEP_COLUMNS = 7 };
+
 /* One row of the step log (fluid.step_log), after each step. */
 static enum mps_status write_step_row(struct run *r, struct mps_err *err)
 {
     if (!r->steps)
         return MPS_OK;
     const struct fluid_step_stats *l = &r->f->last;
-    double v[6] = {l->dt, l->ppe_iterations, l->ppe_rows, l->rows_at_zero,
-                   (double)l->collisions, l->neighbour_build};
+    double v[STEP_COLUMNS] = {l->dt,           l->ppe_iterations,     l->ppe_rows,
+                              l->rows_at_zero, l->tension_solves,     (double)l->collisions,
+                              l->neighbour_build};
     return mps_probes_write(r->steps, r->f->time, v, err);
 }
 
@@ -317,13 +321,14 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
         free(comment);
     }
     if (!st && prm.step_log) {
-        static const char *const cols[6] = {"dt", "ppe_iterations", "ppe_rows",
-                                            "rows_at_zero", "collision_pairs", "neighbour_build"};
+        static const char *const cols[STEP_COLUMNS] = {
+            "dt",          "ppe_iterations",  "ppe_rows",        "rows_at_zero",
+            "tension_solves", "collision_pairs", "neighbour_build"};
         snprintf(path, sizeof path, "%s/%s_steps.csv", r->out, prefix);
         if (r->resumed)
-            return mps_probes_resume(&r->steps, path, r->mark.table_bytes[1], 6, err);
+            return mps_probes_resume(&r->steps, path, r->mark.table_bytes[1], STEP_COLUMNS, err);
         char *comment = mps_prov_comment(r->cs, "fluid_solver");
-        st = mps_probes_open(&r->steps, path, comment, cols, 6, err);
+        st = mps_probes_open(&r->steps, path, comment, cols, STEP_COLUMNS, err);
         free(comment);
     }
     return st;

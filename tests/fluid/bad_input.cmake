@@ -30,6 +30,9 @@ fluid_expect_fail(fluid_bad_unknown_key_in_file "tests/fluid/bad_key.yml:6: flui
 # it read 'abc' as step 0 and wrote an empty system, exit 0
 fluid_expect_fail(fluid_bad_dump_ppe_step "--dump-ppe '12x': not a step number"
                   ${FS} ${DB} ${OUT} --dump-ppe 12x)
+# releasing the rows under tension needs the clamp it replaces (fluid.tension_solves)
+fluid_expect_fail(fluid_bad_tension_without_clamp "fluid.tension_solves: 2 more solves .* fluid.clamp_negative is false"
+                  ${FS} ${DB} ${OUT} --set fluid.clamp_negative=false --set fluid.tension_solves=2)
 fluid_expect_fail(coupler_bad_negative_dp "coupler: .*dp = -0.004: must be > 0"
                   ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set dp=-0.004)
 fluid_expect_fail(coupler_bad_no_scene "neither a fluid .* nor a solid"

@@ -119,6 +119,22 @@ add_test(NAME fluid_pressure_flicker_steps
 add_test(NAME fluid_dambreak_flicker_realisations
   COMMAND sh -c "rm -rf '${FV_OUT}/flicker_realisations' && /usr/bin/python3 bench/flicker_ensemble.py --build '${CMAKE_BINARY_DIR}' --runs 16 --out '${FV_OUT}/flicker_realisations' --max-worst 12"
   WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# fluid_dambreak_flicker_realisations_release: the same 16 realisations with
+# the water holding no tension (fluid.tension_solves = 8, an option;
+# docs/pressure.md, "Water that holds no tension"): at most one of them with a
+# snapshot after 0.05 s with more than 5% of the interior fluid at P = 0, the
+# issue's target. Measured (2026-12-06, seeds 1-96): 1 of 96, seed 4 (21.1%:
+# its front's toe hits the wall's foot at 0.253 s and throws a particle out at
+# 22 m/s, the step falls to 6.5e-5 s and jumps back 2.5-fold at 0.258 s), the
+# worst of the other 95 4.4%; with the clamp (the default) 20 of 96 at
+# 5.2-13.3%, 3 of them among seeds 1-16 (8.1-8.8%). A count, not a worst case,
+# since about one draw in a hundred is such an impact: at one in 96 the chance
+# that a change of build puts two of these 16 over 5% is about 1%; with the
+# clamp's one in five, the chance that 16 seeds show at most one is about 12%,
+# and fluid_ppe_terms checks the release directly.
+add_test(NAME fluid_dambreak_flicker_realisations_release
+  COMMAND sh -c "rm -rf '${FV_OUT}/flicker_realisations_release' && /usr/bin/python3 bench/flicker_ensemble.py --build '${CMAKE_BINARY_DIR}' --runs 16 --out '${FV_OUT}/flicker_realisations_release' --set fluid.tension_solves=8 --max-worst 5 --allow 1"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 # fluid_pressure_flicker_laplacian: the option pair of docs/pressure.md, "The
 # divergence on the Laplacian's stencil" (fluid.divergence_stencil =
 # laplacian, fluid.density_weight = quadratic), on the 8 mm dam break to 0.3 s:
