@@ -32,9 +32,9 @@ usage: test_ppe_terms.py FLUID_SOLVER OUT_DIR
    of rho g H (2.9 Pa; H = 0.292 m, the column): the PCG stops at a relative
    residual of 1e-6, and where the two hold the same rows they differ by
    far less (measured 1.4e-4 Pa, step 104, 6 more solves); a held set off
-   by a row moves the pressure by up to 75 Pa (the median over 20 of the
-   held rows let go one at a time in that step; up to 485 Pa). The rows it leaves at
-   P <= 0 must match the step log within 2 rows (as in 2.; measured 43 and
+   by a row moves the pressure (at its most-moved row) by 75 Pa in the
+   median over 20 of that step's held rows let go one at a time, 0-485 Pa.
+   The rows it leaves at P <= 0 must match the step log within 2 rows (as in 2.; measured 43 and
    43), and the release must have acted: the one-solve answer of the same
    system must have at least 10 rows more at P <= 0 (measured 308).
 Exit 0 if all hold."""
