@@ -68,17 +68,18 @@ def decompose(A, b, parts):
     return P, mismatch
 
 
-def complementarity(A, b, max_solves=50):
+def complementarity(A, b, first=None, max_solves=50):
     """The pressure with no tension, as fluid.tension_solves computes it but
     with direct solves: P >= 0, A P = b where P > 0, A P - b >= 0 where P = 0
     (the water there may only expand). A primal-dual active set: hold the
     rows that come out negative at 0, let go the held rows whose equation
     asks for a pressure, until the set settles. Every row may be held: the
     dumps this reads have fluid rows only (walls and solids as ghosts).
-    Returns (P, solves after the first); None for P if it did not settle."""
+    first: the one-solve answer A^-1 b if the caller has it. Returns (P,
+    solves after the first); None for P if it did not settle."""
     n = b.size
     A = A.tocsr()
-    P = scipy.sparse.linalg.splu(A.tocsc()).solve(b)
+    P = scipy.sparse.linalg.splu(A.tocsc()).solve(b) if first is None else first
     held = P < 0.0
     if not held.any():
         return P, 0
@@ -131,13 +132,13 @@ def main():
         zero = total <= 0.0
         rec = {"rows": int(b.size), "at_zero": int(zero.sum()),
                "all": means(P, np.ones(b.size, bool)), "zero": means(P, zero)}
-        released, solves = complementarity(A, b)
+        released, solves = complementarity(A, b, total)
         if released is not None:
             rec["released_at_zero"] = int((released <= 0.0).sum())
             rec["released_solves"] = solves
-            if "pressure" in rows_of(d).dtype.names:
-                rec["pressure_vs_released"] = float(
-                    np.abs(rows_of(d)["pressure"] - released).max())
+            rows = rows_of(d)
+            if "pressure" in rows.dtype.names:
+                rec["pressure_vs_released"] = float(np.abs(rows["pressure"] - released).max())
         print(f"{d}: {b.size} rows, {zero.sum()} at P <= 0 ({100.0 * zero.mean():.1f}%); "
               + (f"with no tension {rec['released_at_zero']} ({solves} more solves); "
                  if released is not None else "no tension: did not settle; ")

@@ -33,7 +33,8 @@ usage: test_ppe_terms.py FLUID_SOLVER OUT_DIR
    residual of 1e-6, and where the two hold the same rows they differ by
    far less (measured 1.4e-4 Pa, step 104, 6 more solves); a held set off
    by a row moves the pressure (at its most-moved row) by 75 Pa in the
-   median over 20 of that step's held rows let go one at a time, 0-485 Pa.
+   median over 20 of that step's held rows let go one at a time, 0-485 Pa
+   (bench/tension_sets.py DUMP --sweeps 0 --let-go 20).
    The rows it leaves at P <= 0 must match the step log within 2 rows (as in 2.; measured 43 and
    43), and the release must have acted: the one-solve answer of the same
    system must have at least 10 rows more at P <= 0 (measured 308).
@@ -133,14 +134,15 @@ def dambreak_released(solver, out, fails):
         fails.append('dam break, no tension: fluid_solver --dump-ppe failed')
         return
     A, b, _, _ = ppe_terms.read_dir(d)
-    P, _ = ppe_terms.complementarity(A, b)
+    first = scipy.sparse.linalg.splu(A).solve(b)
+    P, _ = ppe_terms.complementarity(A, b, first)
     if P is None:
         fails.append('dam break, no tension: the direct complementarity solve did not settle')
         return
     solver_p = ppe_terms.rows_of(d)['pressure']
     diff = float(np.abs(solver_p - P).max())
     band = 1e-3 * RHO * G * H_COLUMN
-    one_solve = int((scipy.sparse.linalg.splu(A).solve(b) <= 0.0).sum())
+    one_solve = int((first <= 0.0).sum())
     got, want = int((P <= 0.0).sum()), int(zero[k])
     print('dam break, no tension, step %d (t = %.4f s, %d more solves): the solver\'s pressure '
           'against the direct complementarity solve: at most %.3g Pa apart (band %.3g); rows '
