@@ -68,21 +68,24 @@ def decompose(A, b, parts):
     return P, mismatch
 
 
-def complementarity(A, b, first=None, max_solves=50):
+def complementarity(A, b, first=None, held=None, max_solves=50):
     """The pressure with no tension, as fluid.tension_solves computes it but
     with direct solves: P >= 0, A P = b where P > 0, A P - b >= 0 where P = 0
     (the water there may only expand). A primal-dual active set: hold the
     rows that come out negative at 0, let go the held rows whose equation
     asks for a pressure, until the set settles. Every row may be held: the
     dumps this reads have fluid rows only (walls and solids as ghosts).
-    first: the one-solve answer A^-1 b if the caller has it. Returns (P,
-    solves after the first); None for P if it did not settle."""
+    first: the one-solve answer A^-1 b if the caller has it; held: the rows
+    to hold first instead of its negative ones. Returns (P, solves after the
+    first, counting the one that confirms the set); None for P if it did not
+    settle."""
     n = b.size
     A = A.tocsr()
-    P = scipy.sparse.linalg.splu(A.tocsc()).solve(b) if first is None else first
-    held = P < 0.0
-    if not held.any():
-        return P, 0
+    if held is None:
+        P = scipy.sparse.linalg.splu(A.tocsc()).solve(b) if first is None else first
+        held = P < 0.0
+        if not held.any():
+            return P, 0
     for solves in range(1, max_solves + 1):
         free = ~held
         P = np.zeros(n)

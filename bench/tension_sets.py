@@ -39,20 +39,6 @@ def sweeps(A, b, P, k):
     return P
 
 
-def settle_from(A, b, held, max_solves=50):
-    """Solves of the active set from held until it settles (the last confirms)."""
-    for solves in range(1, max_solves + 1):
-        free = ~held
-        P = np.zeros(b.size)
-        if free.any():
-            P[free] = scipy.sparse.linalg.splu(A[free][:, free].tocsc()).solve(b[free])
-        new = np.where(held, A @ P - b >= 0.0, P < 0.0)
-        if (new == held).all():
-            return solves
-        held = new
-    return None
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("dirs", nargs="+")
@@ -79,7 +65,7 @@ def main():
             P = sweeps(A, b, np.maximum(first, 0.0), k)
             e = P - settled
             print(f"  {k:3d} sweeps: {int((P <= 0.0).sum()):5d} at 0, "
-                  f"{settle_from(A, b, P <= 0.0)} solves to settle; "
+                  f"{ppe_terms.complementarity(A, b, held=P <= 0.0)[1]} solves to settle; "
                   f"from the settled pressure at most {np.abs(e).max():.1f} Pa, "
                   f"RMS {np.sqrt(np.mean(e ** 2)):.2f} Pa")
         if a.let_go:
