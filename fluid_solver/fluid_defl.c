@@ -32,6 +32,13 @@ struct fluid_defl {
     double *azval;
     int *ztptr, *ztrow;  /* (A Z)^T in CSR: for each aggregate, the rows that touch it */
     double *ztval;
+    /* for a set-up of new values on the same pattern (fluid_defl_setup's
+     * same_pattern): each entry of A's slot in its row's A Z list, and each
+     * A Z entry's place in (A Z)^T */
+    int *entslot, *azpos;
+    int pattern_n, pattern_nagg;   /* rows and aggregates they hold for; -1: none */
+    size_t pattern_nnz;
+    const int *pattern_agg;
     int *ecount;         /* entries of E's column a (upper triangle) */
     int *mark;           /* per thread, per aggregate: stamp, slot, count */
     size_t cap_m, cap_n, cap_az, cap_zt, cap_mark;
@@ -62,6 +69,7 @@ enum mps_status fluid_defl_create(struct fluid_defl **out, int nthreads, int par
         free(s);
         return mps_err_set(err, MPS_ELIB, "pcg_defl: cholmod_start failed");
     }
+    s->pattern_n = -1;
     s->cm.print = 0; /* errors come back through err, not stderr */
     /* simplicial: no BLAS (see direct() in fluid_linsolve.c on OpenBLAS
      * threads), and E is small and sparse; one ordering, without trying
@@ -85,6 +93,8 @@ void fluid_defl_destroy(struct fluid_defl **d)
     free(s->azlen);
     free(s->azcol);
     free(s->azval);
+    free(s->entslot);
+    free(s->azpos);
     free(s->ztptr);
     free(s->ztrow);
     free(s->ztval);
@@ -159,8 +169,8 @@ static enum mps_status defl_aggregates(struct fluid_defl *s, int n, struct mps_e
  * a predictor can learn): a key that is not new still writes itself and a
  * zero into the first free slot, which the next new key overwrites, so the
  * list needs room for one entry per call. */
-static inline void accumulate(int key, double v, int tag, int *stamp, int *slot, int *keys,
-                              double *vals, int *len)
+static inline int accumulate(int key, double v, int tag, int *stamp, int *slot, int *keys,
+                             double *vals, int *len)
 {
     const int fresh = stamp[key] != tag, at = fresh ? *len : slot[key];
     stamp[key] = tag;
@@ -169,6 +179,7 @@ static inline void accumulate(int key, double v, int tag, int *stamp, int *slot,
     vals[*len] = 0.0;
     vals[at] += v;
     *len += fresh;
+    return at;
 }
 
 /* Sorts keys (and their values) by key: E's columns are a few tens long. */
@@ -252,6 +263,8 @@ static cholmod_sparse *coarse_matrix(struct fluid_defl *s, int n, struct mps_err
     return E;
 }
 
+static enum mps_status coarse_factor(struct fluid_defl *s, int n, struct mps_err *err);
+
 /* A Z (row i's distinct aggregates and the sums of its entries in each,
  * stored from rowptr[i]), (A Z)^T, E = Z^T A Z (upper triangle) and its
  * factor, all but the factor in parallel. The transpose is a counting sort
@@ -260,7 +273,7 @@ static cholmod_sparse *coarse_matrix(struct fluid_defl *s, int n, struct mps_err
  * vector in order (unsorted, it waited on the loads: 5.5% of the 80k-particle
  * dam break's samples against 2%). */
 enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A,
-                                 struct mps_err *err)
+                                 int same_pattern, struct mps_err *err)
 {
     const int n = A->n;
     enum mps_status rc = defl_aggregates(s, n, err);
@@ -287,6 +300,9 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
         size_t c = nnz + nnz / 8 + 1;
         s->azcol = mps_realloc_or_flag(s->azcol, c, sizeof *s->azcol, &fail);
         s->azval = mps_realloc_or_flag(s->azval, c, sizeof *s->azval, &fail);
+        s->entslot = mps_realloc_or_flag(s->entslot, c, sizeof *s->entslot, &fail);
+        s->azpos = mps_realloc_or_flag(s->azpos, c, sizeof *s->azpos, &fail);
+        s->pattern_n = -1;
         if (!fail)
             s->cap_az = c;
     }
@@ -300,6 +316,25 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
                                             "%d aggregates)", n, m);
     int *azlen = s->azlen, *azcol = s->azcol, *ztptr = s->ztptr;
     double *azval = s->azval;
+    if (same_pattern && s->pattern_n == n && s->pattern_nnz == nnz && s->pattern_agg == agg &&
+        s->pattern_nagg == m) {
+        /* the last set-up's lists, refilled in the order it summed them:
+         * the same A Z and E, to the bit, as a full set-up would give */
+        const int *entslot = s->entslot, *azpos = s->azpos;
+#pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static)
+        for (int i = 0; i < n; i++) {
+            const int base = A->rowptr[i];
+            double *v = azval + base;
+            for (int q = 0; q < azlen[i]; q++)
+                v[q] = 0.0;
+            for (int k = base; k < A->rowptr[i + 1]; k++)
+                v[entslot[k]] += A->val[k];
+            for (int q = 0; q < azlen[i]; q++)
+                s->ztval[azpos[base + q]] = v[q];
+        }
+        return coarse_factor(s, n, err);
+    }
+    s->pattern_n = -1;
 #pragma omp parallel num_threads(s->nthreads) if (n >= s->par_min_rows)
     {
         const int t = omp_get_thread_num(), nt = omp_get_num_threads();
@@ -314,8 +349,8 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
             const int base = A->rowptr[i];
             int len = 0;
             for (int k = base; k < A->rowptr[i + 1]; k++)
-                accumulate(agg[A->col[k]], A->val[k], i, stamp, slot, azcol + base, azval + base,
-                           &len);
+                s->entslot[k] = accumulate(agg[A->col[k]], A->val[k], i, stamp, slot,
+                                           azcol + base, azval + base, &len);
             azlen[i] = len;
             for (int q = 0; q < len; q++)
                 count[azcol[base + q]]++;
@@ -348,6 +383,7 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
                 const int base = A->rowptr[i];
                 for (int q = 0; q < azlen[i]; q++) {
                     int to = count[azcol[base + q]]++;
+                    s->azpos[base + q] = to;
                     s->ztrow[to] = i;
                     s->ztval[to] = azval[base + q];
                 }
@@ -356,7 +392,18 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
     if (fail)
         return mps_err_set(err, MPS_ENOMEM, "pcg_defl: cannot allocate (A Z)^T (%d entries)",
                            ztptr[m]);
+    s->pattern_n = n;
+    s->pattern_nnz = nnz;
+    s->pattern_agg = agg;
+    s->pattern_nagg = m;
+    return coarse_factor(s, n, err);
+}
 
+/* E from (A Z)^T, and its factor */
+static enum mps_status coarse_factor(struct fluid_defl *s, int n, struct mps_err *err)
+{
+    enum mps_status rc = MPS_OK;
+    const int m = s->nagg;
     cholmod_common *cm = &s->cm;
     cholmod_sparse *E = coarse_matrix(s, n, err, &rc);
     if (!E)

@@ -25,9 +25,13 @@ enum mps_status fluid_defl_set_aggregates(struct fluid_defl *d, const int *agg, 
                                           struct mps_err *err);
 
 /* A Z, E and E's factor for matrix A. An empty aggregate (or an A that is not
- * positive definite) is reported as MPS_ESOLVE. */
+ * positive definite) is reported as MPS_ESOLVE. same_pattern: A has the
+ * pattern (rowptr, col) of the last set-up's matrix and the aggregates are
+ * the same array: A Z's lists are refilled with the new values (the same
+ * numbers a full set-up gives, for a third of its cost); without a last
+ * set-up of that size and those aggregates, a full one. */
 enum mps_status fluid_defl_setup(struct fluid_defl *d, const struct fluid_csr *A,
-                                 struct mps_err *err);
+                                 int same_pattern, struct mps_err *err);
 
 /* x += Z c, r -= A Z c with c = E^-1 Z^T r, so that Z^T r = 0; r.r in *rr. */
 enum mps_status fluid_defl_start(struct fluid_defl *d, const struct fluid_csr *A, double *x,

@@ -88,6 +88,7 @@ struct fluid_linsolve {
     int max_iter;
     int nthreads;        /* resolved: > 0 */
     int trusted;         /* structure well formed by construction: no check_input */
+    int same_pattern;    /* the next solve's A: the last one's pattern (one solve) */
 
     /* PCG work vectors, capacity cap_n */
     size_t cap_n;
@@ -316,6 +317,11 @@ int fluid_linsolve_coarse_size(const struct fluid_linsolve *s)
 void fluid_linsolve_trust_structure(struct fluid_linsolve *s, int trusted)
 {
     s->trusted = trusted;
+}
+
+void fluid_linsolve_same_pattern(struct fluid_linsolve *s)
+{
+    s->same_pattern = 1;
 }
 
 enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
@@ -916,7 +922,7 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
     }
     if (s->ops->precond_setup && (rc = s->ops->precond_setup(s, A, err)))
         return rc;
-    if (s->defl && (rc = fluid_defl_setup(s->defl, A, err)))
+    if (s->defl && (rc = fluid_defl_setup(s->defl, A, s->same_pattern, err)))
         return rc;
     double t2 = omp_get_wtime();
     st->t_factor = t2 - t1;
@@ -1173,7 +1179,11 @@ enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct flui
     int iterative = s->ops->iterative;
     enum mps_status rc =
         check_input(s, A, b, iterative ? x : NULL, !(iterative && s->trusted), err);
-    if (rc || A->n == 0)
+    if (rc || A->n == 0) {
+        s->same_pattern = 0;
         return rc;
-    return s->ops->solve(s, A, b, x, st, err);
+    }
+    rc = s->ops->solve(s, A, b, x, st, err);
+    s->same_pattern = 0;
+    return rc;
 }

@@ -71,6 +71,12 @@ int fluid_linsolve_coarse_size(const struct fluid_linsolve *s);
  * the initial residual, and reported row by row as without it. */
 void fluid_linsolve_trust_structure(struct fluid_linsolve *s, int trusted);
 
+/* The next solve's matrix has the last solve's pattern (rowptr and col,
+ * entry for entry) and, for pcg_defl, the same aggregates: only values
+ * changed. pcg_defl then refills its coarse space's lists instead of
+ * building them (the same numbers, to the bit). Holds for one solve. */
+void fluid_linsolve_same_pattern(struct fluid_linsolve *s);
+
 /* Solves A x = b. On entry x holds the initial guess (iterative methods start
  * from it: warm start from the previous step's pressure); on exit the
  * solution. */

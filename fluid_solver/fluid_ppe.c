@@ -577,6 +577,7 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
                 f->sol[r] = 0.0;
         }
         struct fluid_linsolve_stats ls;
+        fluid_linsolve_same_pattern(f->ls); /* held rows keep their zeros */
         st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, &ls, err);
         if (st) {
             mps_err_prefix(err, "PPE at t = %.6g s, solve %d with %d rows under tension held "
