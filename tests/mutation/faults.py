@@ -149,7 +149,7 @@ FAULTS = [
       old='    if (p->kappa_step_decay > 0.0 && p->kappa_step_decay * f->dt_kappa > dtk)',
       new='    if (0 && p->kappa_step_decay > 0.0 && p->kappa_step_decay * f->dt_kappa > dtk)',
       what='the reference step of Eq. 23 follows a dropped CFL step at once (the 1/dt^2 jump at an impact)',
-      hint='fluid_dambreak_flicker_realisations|coupled_plate_kappa_step_decay'),
+      hint='test_fluid_step|fluid_dambreak_flicker_realisations|coupled_plate_kappa_step_decay'),
     F(id='kappa_step_decay_expansion_off', eq='Eq. 23 (fluid.kappa_step_decay_expansion)',
       file='fluid_solver/fluid_ppe.c',
       old='    if (p->kappa_step_decay_expansion > 0.0 &&',
