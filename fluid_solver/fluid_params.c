@@ -119,13 +119,14 @@ const struct mps_key_spec fluid_case_keys[] = {
      "subtract the neighbourhood minimum pressure (repulsive pair terms only)"},
     {"fluid.clamp_negative", MPS_KEY_BOOL, "true", 0, 0, 0, NULL, "",
      "set negative PPE pressures to zero"},
-    {"fluid.tension_solves", MPS_KEY_INT, "0", 0, 50, 0, NULL, "",
+    {"fluid.tension_solves", MPS_KEY_INT, "8", 0, 50, 0, NULL, "",
      "water holds no tension: up to this many more PPE solves per step with the fluid rows "
      "under tension held at P = 0, released or taken back until the set settles (a "
      "complementarity problem: P >= 0, and where P = 0 the water may only expand); what is "
-     "still negative after them is clamped. 0 (default): clamp after the one solve, the "
-     "paper's 4.3; 8 settles nearly every step, at 1.5-1.8 times the step's cost "
-     "(docs/pressure.md, \"Water that holds no tension\"). Needs fluid.clamp_negative"},
+     "still negative after them is clamped. 8 (default) settles nearly every step; 0: "
+     "clamp after the one solve, the paper's 4.3, faster where water splashes "
+     "(docs/pressure.md, \"Water that holds no tension\"). Needs fluid.clamp_negative; "
+     "with fluid.clamp_negative=false the default is 0"},
     {"fluid.collision_distance", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
      "fluid particles closer than this are pushed apart (0: off)"},
     {"fluid.collision_restitution", MPS_KEY_DOUBLE, "0.2", 0, 1, 0, NULL, "",
@@ -368,6 +369,9 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
     p->gradient_min = mps_case_bool(c, "fluid.gradient_min");
     p->clamp_negative = mps_case_bool(c, "fluid.clamp_negative");
     p->tension_solves = (int)mps_case_int(c, "fluid.tension_solves");
+    /* without the clamp the default's re-solves have nothing to replace */
+    if (!p->clamp_negative && strcmp(mps_case_where(c, "fluid.tension_solves"), "default") == 0)
+        p->tension_solves = 0;
     if (!p->clamp_negative && p->tension_solves > 0)
         return mps_err_set(err, MPS_EINPUT,
                            "%s: fluid.tension_solves: %d more solves release the rows the clamp "

@@ -105,7 +105,12 @@ set_tests_properties(coupled_dambreak_plate_3mm PROPERTIES TIMEOUT 600 LABELS va
 add_test(NAME coupled_plate_3mm_breathing
          COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate3_breathing --quiet --set dp=0.003 --set end_time=2 && /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate3_breathing --max-breathing 0.027 --min-within15 0.5"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(coupled_plate_3mm_breathing PROPERTIES TIMEOUT 600 LABELS validation)
+# 150 s alone on two threads with the water holding no tension (the default
+# since 2026-12-06: 1.36 times the clamp's time on the 6 mm plate); over 600 s
+# once in a ctest -j2 beside the other 3 mm plate test (two threads too) and
+# a one-thread run, the threads' spinning barriers oversubscribed; as the
+# other 3 mm test, 900 s.
+set_tests_properties(coupled_plate_3mm_breathing PROPERTIES TIMEOUT 900 LABELS validation)
 
 # coupled_plate_3mm_shifting_weight: the case's shifting along the gradient of
 # (1 - r/re)^2 (fluid.shifting_weight: smooth; docs/pressure.md, "The particle
@@ -116,8 +121,13 @@ set_tests_properties(coupled_plate_3mm_breathing PROPERTIES TIMEOUT 600 LABELS v
 # of 68% lies above every realisation with Eq. 3's weight, so the smooth weight
 # lost (or scaled wrongly toward the singular one) fails the first run; the
 # second must fail it, which keeps the band from being one no run misses.
+# Both runs keep the clamp after one PPE solve (fluid.tension_solves=0), the
+# PPE the band was measured with: with the water holding no tension (the
+# default since 2026-12-06) the smooth weight's lattice start read 63% once
+# (eight jittered realisations one thread each: 75.6 +- 0.9%, against
+# 72.0 +- 1.8% with the clamp), and Eq. 3's weight was not measured so.
 add_test(NAME coupled_plate_3mm_shifting_weight
-         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate3_smooth --quiet --set dp=0.003 --set end_time=2 --set output.interval=0.02 && /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate3_smooth --min-within15 0.68 && ${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate3_mpsweight --quiet --set dp=0.003 --set end_time=2 --set fluid.shifting_weight=mps && ! /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate3_mpsweight --min-within15 0.68"
+         COMMAND sh -c "${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate3_smooth --quiet --set dp=0.003 --set end_time=2 --set output.interval=0.02 --set fluid.tension_solves=0 && /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate3_smooth --min-within15 0.68 && ${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --out ${CMAKE_BINARY_DIR}/test_out/plate3_mpsweight --quiet --set dp=0.003 --set end_time=2 --set fluid.shifting_weight=mps --set fluid.tension_solves=0 && ! /usr/bin/python3 tests/coupler/check_plate_flicker.py ${CMAKE_BINARY_DIR}/test_out/plate3_mpsweight --min-within15 0.68"
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupled_plate_3mm_shifting_weight PROPERTIES TIMEOUT 900 LABELS validation
                      ENVIRONMENT "OMP_NUM_THREADS=2")

@@ -33,6 +33,12 @@ fluid_expect_fail(fluid_bad_dump_ppe_step "--dump-ppe '12x': not a step number"
 # releasing the rows under tension needs the clamp it replaces (fluid.tension_solves)
 fluid_expect_fail(fluid_bad_tension_without_clamp "fluid.tension_solves: 2 more solves .* fluid.clamp_negative is false"
                   ${FS} ${DB} ${OUT} --set fluid.clamp_negative=false --set fluid.tension_solves=2)
+# ... but without the clamp and without the key, the default's re-solves are
+# off, not refused: the run goes, and its step log shows no re-solve
+add_test(NAME fluid_no_clamp_no_tension_solves
+  COMMAND sh -c "rm -rf '${CMAKE_BINARY_DIR}/test_out/no_clamp' && '${FS}' ${DB} --out '${CMAKE_BINARY_DIR}/test_out/no_clamp' --quiet --set dp=0.008 --set end_time=0.02 --set output.interval=0 --set fluid.step_log=true --set fluid.clamp_negative=false && /usr/bin/python3 -c \"import csv, sys; r = list(csv.DictReader(l for l in open(sys.argv[1]) if not l.startswith('#'))); s = sum(int(x['tension_solves']) for x in r); print(len(r), 'steps,', s, 're-solves'); sys.exit(not (len(r) > 5 and s == 0))\" '${CMAKE_BINARY_DIR}/test_out/no_clamp/fluid_steps.csv'"
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(fluid_no_clamp_no_tension_solves PROPERTIES TIMEOUT 60 LABELS unit)
 fluid_expect_fail(coupler_bad_negative_dp "coupler: .*dp = -0.004: must be > 0"
                   ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --set dp=-0.004)
 fluid_expect_fail(coupler_bad_no_scene "neither a fluid .* nor a solid"
