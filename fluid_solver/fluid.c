@@ -246,6 +246,7 @@ void fluid_destroy(struct fluid **pf)
     free(f->row_is_fluid);
     free(f->row_held);
     free(f->row_held_next);
+    free(f->row_local);
     fluid_linsolve_destroy(&f->ls);
     fluid_sensors_destroy(&f->sens);
     free(f);

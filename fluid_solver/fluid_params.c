@@ -127,6 +127,12 @@ const struct mps_key_spec fluid_case_keys[] = {
      "clamp after the one solve, the paper's 4.3, faster where water splashes "
      "(docs/pressure.md, \"Water that holds no tension\"). Needs fluid.clamp_negative; "
      "with fluid.clamp_negative=false the default is 0"},
+    {"fluid.tension_sweeps", MPS_KEY_INT, "10", 0, 100, 0, NULL, "",
+     "where the rows under tension start (with fluid.tension_solves): this many projected "
+     "Gauss-Seidel sweeps (P = max(0, ...)) over the rows within three neighbour rings of "
+     "the first solve's negative ones, from its clamped pressure; the rows they leave at "
+     "P = 0 are the first held set. The same answer, in fewer solves; 0: hold the first "
+     "solve's negative rows (docs/pressure.md, \"Where the held rows start\")"},
     {"fluid.collision_distance", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
      "fluid particles closer than this are pushed apart (0: off)"},
     {"fluid.collision_restitution", MPS_KEY_DOUBLE, "0.2", 0, 1, 0, NULL, "",
@@ -378,6 +384,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
                            "would set to zero, but fluid.clamp_negative is false: set one of "
                            "them to 0/true",
                            mps_case_origin(c), p->tension_solves);
+    p->tension_sweeps = (int)mps_case_int(c, "fluid.tension_sweeps");
     p->collision_dist = mps_case_double(c, "fluid.collision_distance");
     p->collision_restitution = mps_case_double(c, "fluid.collision_restitution");
     p->side_wall_breadth = mps_case_double(c, "fluid.side_walls.breadth");

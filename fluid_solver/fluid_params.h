@@ -84,6 +84,7 @@ struct fluid_params {
     int gradient_min;             /* subtract the neighbourhood minimum pressure */
     int clamp_negative;           /* negative PPE pressures set to 0 */
     int tension_solves;           /* more PPE solves releasing rows under tension (0: clamp) */
+    int tension_sweeps;           /* projected Gauss-Seidel sweeps for the first held set */
     double collision_dist;        /* fraction of dp; 0 = off */
     double collision_restitution;
     double side_wall_breadth;     /* m: 0 = no side walls (2D) */

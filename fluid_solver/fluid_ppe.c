@@ -518,6 +518,101 @@ static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err
     return MPS_OK;
 }
 
+/* The per-row arrays of release_tension, grown together to one capacity. */
+static int grow_held_rows(struct fluid *f, size_t need)
+{
+    if (need <= f->cap_held_rows)
+        return 0;
+    const size_t c = need + need / 2 + 16;
+    void *a = realloc(f->rhs_assembled, c * sizeof(double));
+    if (a)
+        f->rhs_assembled = a;
+    void *b = realloc(f->row_local, c * sizeof(int));
+    if (b)
+        f->row_local = b;
+    void *d = realloc(f->row_is_fluid, c);
+    if (d)
+        f->row_is_fluid = d;
+    void *e = realloc(f->row_held, c);
+    if (e)
+        f->row_held = e;
+    void *g = realloc(f->row_held_next, c);
+    if (g)
+        f->row_held_next = g;
+    if (!a || !b || !d || !e || !g)
+        return -1; /* those that grew stay valid; the capacity stays the smaller */
+    f->cap_held_rows = c;
+    return 0;
+}
+
+/* The first held set, from projected Gauss-Seidel sweeps (fluid.tension_sweeps)
+ * on the assembled system. Holding just the rows the first solve left
+ * negative takes 2-3 more solves a step to settle (4 mm dam break): their
+ * neighbours, computed against them, go negative in turn, and rows held
+ * too early are let go. The sweeps, from the clamped pressure, let the
+ * rows around a negative one feel it clamped; on the recorded event steps
+ * they left within 2-3 rows the set the solves settle on (bench/tension_sets.py).
+ * Only the rows within three neighbour rings of a negative one are swept:
+ * elsewhere the first solve's pressure stands. Serial, in row order, so
+ * the start is the same for any thread count. In: held = the first solve's
+ * negative fluid rows; out: the swept rows at P = 0, and f->sol the swept
+ * pressure (the re-solve's warm start). mark: scratch, one byte a row. */
+static int held_start_sweeps(struct fluid *f, const unsigned char *is_fluid, unsigned char *held,
+                             unsigned char *mark)
+{
+    const int nr = f->nrows;
+    int *local = f->row_local, nlocal = 0;
+    memset(mark, 0, (size_t)nr);
+    for (int r = 0; r < nr; r++)
+        if (held[r]) {
+            mark[r] = 1;
+            local[nlocal++] = r;
+        }
+    for (int ring = 0, from = 0; ring < 3; ring++) {
+        const int to = nlocal;
+        for (int k = from; k < to; k++)
+            for (int e = f->rowptr[local[k]]; e < f->rowptr[local[k] + 1]; e++) {
+                const int q = f->col[e];
+                if (!mark[q]) {
+                    mark[q] = 1;
+                    local[nlocal++] = q;
+                }
+            }
+        from = to;
+    }
+    /* row order: the sweep then runs as a plain Gauss-Seidel over the rows */
+    nlocal = 0;
+    for (int r = 0; r < nr; r++)
+        if (mark[r])
+            local[nlocal++] = r;
+    double *P = f->sol;
+    for (int k = 0; k < nlocal; k++)
+        if (is_fluid[local[k]] && P[local[k]] < 0.0)
+            P[local[k]] = 0.0;
+    for (int sweep = 0; sweep < f->prm.tension_sweeps; sweep++)
+        for (int k = 0; k < nlocal; k++) {
+            const int r = local[k];
+            double off = 0.0, diag = 0.0;
+            for (int e = f->rowptr[r]; e < f->rowptr[r + 1]; e++) {
+                if (f->col[e] == r)
+                    diag = f->val[e];
+                else
+                    off += f->val[e] * P[f->col[e]];
+            }
+            if (!(diag > 0.0))
+                continue; /* not the PPE's M-matrix row: leave it as solved */
+            const double v = (f->rhs[r] - off) / diag;
+            P[r] = (is_fluid[r] && v < 0.0) ? 0.0 : v;
+        }
+    int nheld = 0;
+    for (int k = 0; k < nlocal; k++) {
+        const int r = local[k];
+        held[r] = is_fluid[r] && P[r] <= 0.0;
+        nheld += held[r];
+    }
+    return nheld;
+}
+
 /* Water holds no tension (fluid.tension_solves). Clamping the solution
  * after one solve leaves each row next to a negative one with the pressure
  * computed against that negative value, too low: in the 4 mm dam break's
@@ -528,8 +623,9 @@ static enum mps_status ppe_aggregates(struct fluid *f, int *nagg, struct mps_err
  * the rest (A P = b, P >= 0), a linear complementarity problem; A is an
  * M-matrix, for which the primal-dual active set below (hold the rows
  * that came out negative, let go the held ones whose equation asks for a
- * pressure, solve again) settles in a few solves. The held rows are
- * decoupled, not removed, so the matrix keeps its pattern and rows. */
+ * pressure, solve again) settles in a few solves, to the one solution
+ * whatever the set it starts from. The held rows are decoupled, not
+ * removed, so the matrix keeps its pattern and rows. */
 static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_stats *stats,
                                        struct mps_err *err)
 {
@@ -537,16 +633,8 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
     const size_t nnz = (size_t)f->rowptr[nr];
     if (grow((void **)&f->val_assembled, &f->cap_held_nnz, nnz + 1, sizeof(double)))
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %zu nonzeros", nnz);
-    size_t c1 = f->cap_held_rows, c2 = f->cap_held_rows, c3 = f->cap_held_rows,
-           c4 = f->cap_held_rows;
-    if (grow((void **)&f->rhs_assembled, &c1, (size_t)nr + 1, sizeof(double)) ||
-        grow((void **)&f->row_is_fluid, &c2, (size_t)nr + 1, 1) ||
-        grow((void **)&f->row_held, &c3, (size_t)nr + 1, 1) ||
-        grow((void **)&f->row_held_next, &c4, (size_t)nr + 1, 1))
+    if (grow_held_rows(f, (size_t)nr + 1))
         return mps_err_set(err, MPS_ENOMEM, "PPE: out of memory for %d rows", nr);
-    f->cap_held_rows = c1 < c2 ? c1 : c2;
-    f->cap_held_rows = f->cap_held_rows < c3 ? f->cap_held_rows : c3;
-    f->cap_held_rows = f->cap_held_rows < c4 ? f->cap_held_rows : c4;
     unsigned char *is_fluid = f->row_is_fluid, *held = f->row_held, *next = f->row_held_next;
     double *val0 = f->val_assembled, *rhs0 = f->rhs_assembled;
     for (size_t i = 0; i < f->ps.n; i++)
@@ -559,6 +647,8 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
     }
     if (nheld == 0)
         return MPS_OK;
+    if (f->prm.tension_sweeps > 0)
+        nheld = held_start_sweeps(f, is_fluid, held, next);
     memcpy(val0, f->val, nnz * sizeof(double));
     memcpy(rhs0, f->rhs, (size_t)nr * sizeof(double));
     struct fluid_csr A = {nr, f->rowptr, f->col, f->val};
