@@ -7,6 +7,7 @@
 
 #include "fluid_shadow.h"
 #include "mps_kernel.h"
+#include "mps_mem.h"
 #include "mps_omp.h"
 #include "mps_simd.h"
 
@@ -524,22 +525,13 @@ static int grow_held_rows(struct fluid *f, size_t need)
     if (need <= f->cap_held_rows)
         return 0;
     const size_t c = need + need / 2 + 16;
-    void *a = realloc(f->rhs_assembled, c * sizeof(double));
-    if (a)
-        f->rhs_assembled = a;
-    void *b = realloc(f->row_local, c * sizeof(int));
-    if (b)
-        f->row_local = b;
-    void *d = realloc(f->row_is_fluid, c);
-    if (d)
-        f->row_is_fluid = d;
-    void *e = realloc(f->row_held, c);
-    if (e)
-        f->row_held = e;
-    void *g = realloc(f->row_held_next, c);
-    if (g)
-        f->row_held_next = g;
-    if (!a || !b || !d || !e || !g)
+    int fail = 0;
+    f->rhs_assembled = mps_realloc_or_flag(f->rhs_assembled, c, sizeof(double), &fail);
+    f->row_local = mps_realloc_or_flag(f->row_local, c, sizeof(int), &fail);
+    f->row_is_fluid = mps_realloc_or_flag(f->row_is_fluid, c, 1, &fail);
+    f->row_held = mps_realloc_or_flag(f->row_held, c, 1, &fail);
+    f->row_held_next = mps_realloc_or_flag(f->row_held_next, c, 1, &fail);
+    if (fail)
         return -1; /* those that grew stay valid; the capacity stays the smaller */
     f->cap_held_rows = c;
     return 0;
