@@ -246,7 +246,8 @@ void fluid_destroy(struct fluid **pf)
     free(f->row_is_fluid);
     free(f->row_held);
     free(f->row_held_next);
-    free(f->row_local);
+    free(f->row_list);
+    free(f->row_touched);
     fluid_linsolve_destroy(&f->ls);
     fluid_sensors_destroy(&f->sens);
     free(f);

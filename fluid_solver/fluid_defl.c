@@ -40,6 +40,8 @@ struct fluid_defl {
     size_t pattern_nnz;
     const int *pattern_agg;
     int *ecount;         /* entries of E's column a (upper triangle) */
+    int *ecols;          /* a refill of some rows: E's columns they touch, m */
+    cholmod_sparse *E;   /* the last set-up's E, kept: a refill has its pattern */
     int *mark;           /* per thread, per aggregate: stamp, slot, count */
     size_t cap_m, cap_n, cap_az, cap_zt, cap_mark;
     double *crhs;        /* coarse right-hand side, m */
@@ -86,6 +88,7 @@ void fluid_defl_destroy(struct fluid_defl **d)
     if (!s)
         return;
     cholmod_free_factor(&s->Lc, &s->cm);
+    cholmod_free_sparse(&s->E, &s->cm);
     cholmod_free_dense(&s->Xc, &s->cm);
     cholmod_free_dense(&s->Yc, &s->cm);
     cholmod_free_dense(&s->Ec, &s->cm);
@@ -99,6 +102,7 @@ void fluid_defl_destroy(struct fluid_defl **d)
     free(s->ztrow);
     free(s->ztval);
     free(s->ecount);
+    free(s->ecols);
     free(s->mark);
     free(s->crhs);
     free(s->own_agg);
@@ -198,6 +202,30 @@ static void sort_column(int *keys, double *vals, int len)
     }
 }
 
+/* Column a of E's upper triangle into rows/vals (its ecount[a] slots):
+ * summed over (A Z)^T's row a in its order, then sorted, so that a column
+ * built again from the same values is the same to the bit. stamp, slot: m
+ * ints each, no stamp equal to a on entry. */
+static void coarse_column(const struct fluid_defl *s, int a, int *stamp, int *slot, int *rows,
+                          double *vals)
+{
+    const int *agg = s->agg;
+    int len = 0;
+    for (int k = s->ztptr[a]; k < s->ztptr[a + 1]; k++) {
+        int b = agg[s->ztrow[k]];
+        if (b > a)
+            continue;
+        if (stamp[b] != a) {   /* branches here: the column has exactly ecount[a] slots */
+            stamp[b] = a;
+            slot[b] = len;
+            rows[len] = b;
+            vals[len++] = 0.0;
+        }
+        vals[slot[b]] += s->ztval[k];
+    }
+    sort_column(rows, vals, len);
+}
+
 /* E's upper triangle in CHOLMOD's CSC from (A Z)^T: column a holds, for each
  * aggregate b <= a, E_ba = sum over the entries of (A Z)^T row a whose row
  * lies in b. A count pass sizes the columns, a second fills them. */
@@ -241,29 +269,30 @@ static cholmod_sparse *coarse_matrix(struct fluid_defl *s, int n, struct mps_err
         for (int b = 0; b < m; b++)
             stamp[b] = -1;
 #pragma omp for schedule(static)
-        for (int a = 0; a < m; a++) {
-            /* branches here: the column has exactly ecount[a] slots */
-            int *rows = ei + ep[a], len = 0;
-            double *vals = ex + ep[a];
-            for (int k = ztptr[a]; k < ztptr[a + 1]; k++) {
-                int b = agg[ztrow[k]];
-                if (b > a)
-                    continue;
-                if (stamp[b] != a) {
-                    stamp[b] = a;
-                    slot[b] = len;
-                    rows[len] = b;
-                    vals[len++] = 0.0;
-                }
-                vals[slot[b]] += s->ztval[k];
-            }
-            sort_column(rows, vals, len);
-        }
+        for (int a = 0; a < m; a++)
+            coarse_column(s, a, stamp, slot, ei + ep[a], ex + ep[a]);
     }
     return E;
 }
 
 static enum mps_status coarse_factor(struct fluid_defl *s, int n, struct mps_err *err);
+
+/* Row i of A Z from A's row i, summed in the order the full set-up used
+ * (entslot), and written to its places in (A Z)^T (azpos). */
+static void refill_row(struct fluid_defl *s, const struct fluid_csr *A, int i)
+{
+    const int base = A->rowptr[i];
+    double *v = s->azval + base;
+    for (int q = 0; q < s->azlen[i]; q++)
+        v[q] = 0.0;
+    for (int k = base; k < A->rowptr[i + 1]; k++)
+        v[s->entslot[k]] += A->val[k];
+    for (int q = 0; q < s->azlen[i]; q++)
+        s->ztval[s->azpos[base + q]] = v[q];
+}
+
+static enum mps_status coarse_refill(struct fluid_defl *s, const struct fluid_csr *A,
+                                     const int *rows, int nrows, struct mps_err *err);
 
 /* A Z (row i's distinct aggregates and the sums of its entries in each,
  * stored from rowptr[i]), (A Z)^T, E = Z^T A Z (upper triangle) and its
@@ -273,7 +302,8 @@ static enum mps_status coarse_factor(struct fluid_defl *s, int n, struct mps_err
  * vector in order (unsorted, it waited on the loads: 5.5% of the 80k-particle
  * dam break's samples against 2%). */
 enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A,
-                                 int same_pattern, struct mps_err *err)
+                                 int same_pattern, const int *rows, int nrows,
+                                 struct mps_err *err)
 {
     const int n = A->n;
     enum mps_status rc = defl_aggregates(s, n, err);
@@ -287,6 +317,7 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
         s->ztptr = mps_realloc_or_flag(s->ztptr, c, sizeof *s->ztptr, &fail);
         s->ecount = mps_realloc_or_flag(s->ecount, c, sizeof *s->ecount, &fail);
         s->crhs = mps_realloc_or_flag(s->crhs, c, sizeof *s->crhs, &fail);
+        s->ecols = mps_realloc_or_flag(s->ecols, c, sizeof *s->ecols, &fail);
         if (!fail)
             s->cap_m = c;
     }
@@ -320,19 +351,18 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
         s->pattern_nagg == m) {
         /* the last set-up's lists, refilled in the order it summed them:
          * the same A Z and E, to the bit, as a full set-up would give */
-        const int *entslot = s->entslot, *azpos = s->azpos;
+        if (!rows) {
 #pragma omp parallel for num_threads(s->nthreads) if (n >= s->par_min_rows) schedule(static)
-        for (int i = 0; i < n; i++) {
-            const int base = A->rowptr[i];
-            double *v = azval + base;
-            for (int q = 0; q < azlen[i]; q++)
-                v[q] = 0.0;
-            for (int k = base; k < A->rowptr[i + 1]; k++)
-                v[entslot[k]] += A->val[k];
-            for (int q = 0; q < azlen[i]; q++)
-                s->ztval[azpos[base + q]] = v[q];
+            for (int i = 0; i < n; i++)
+                refill_row(s, A, i);
+        } else {
+#pragma omp parallel for num_threads(s->nthreads) if (nrows >= s->par_min_rows) schedule(static)
+            for (int k = 0; k < nrows; k++)
+                refill_row(s, A, rows[k]);
         }
-        return coarse_factor(s, n, err);
+        if (!s->E || !s->Lc)
+            return coarse_factor(s, n, err);
+        return coarse_refill(s, A, rows, nrows, err);
     }
     s->pattern_n = -1;
 #pragma omp parallel num_threads(s->nthreads) if (n >= s->par_min_rows)
@@ -399,16 +429,82 @@ enum mps_status fluid_defl_setup(struct fluid_defl *s, const struct fluid_csr *A
     return coarse_factor(s, n, err);
 }
 
-/* E from (A Z)^T, and its factor */
+/* E's factor from the values now in s->E, on the symbolic factor s->Lc:
+ * CHOLMOD keeps the analysis for a matrix of the same pattern. On failure
+ * E and the factor are dropped (the next set-up builds them again). */
+static enum mps_status coarse_numeric(struct fluid_defl *s, struct mps_err *err)
+{
+    cholmod_common *cm = &s->cm;
+    enum mps_status rc = MPS_OK;
+    int ok = cholmod_factorize(s->E, s->Lc, cm) && cm->status >= CHOLMOD_OK;
+    if (ok && cm->status != CHOLMOD_NOT_POSDEF) {
+        s->coarse_n = s->nagg;
+        return MPS_OK;
+    }
+    if (cm->status == CHOLMOD_NOT_POSDEF)
+        rc = mps_err_set(err, MPS_ESOLVE,
+                         "pcg_defl: the coarse matrix Z^T A Z (%d aggregates) is not positive "
+                         "definite: A is not, or an aggregate has no row",
+                         s->nagg);
+    else
+        rc = coarse_fail(s, "cholmod_factorize", err);
+    cholmod_free_factor(&s->Lc, cm);
+    cholmod_free_sparse(&s->E, cm);
+    return rc;
+}
+
+/* E's columns that the given rows of A Z touch (all of them for rows =
+ * NULL) built again in the kept E, and its factor on the kept analysis:
+ * E's pattern is the last set-up's. Each column is built as the full
+ * set-up builds it, so the factor is the same to the bit. */
+static enum mps_status coarse_refill(struct fluid_defl *s, const struct fluid_csr *A,
+                                     const int *rows, int nrows, struct mps_err *err)
+{
+    const int m = s->nagg;
+    int *cols = s->ecols, ncols = m;
+    if (rows) {
+        int *seen = s->mark; /* thread 0's stamps, reset below */
+        memset(seen, 0, (size_t)m * sizeof *seen);
+        ncols = 0;
+        for (int k = 0; k < nrows; k++) {
+            const int base = A->rowptr[rows[k]];
+            for (int q = 0; q < s->azlen[rows[k]]; q++) {
+                const int a = s->azcol[base + q];
+                if (!seen[a]) {
+                    seen[a] = 1;
+                    cols[ncols++] = a;
+                }
+            }
+        }
+    }
+    const int *ep = s->E->p;
+    int *ei = s->E->i;
+    double *ex = s->E->x;
+#pragma omp parallel num_threads(s->nthreads) if (ncols >= s->par_min_rows)
+    {
+        int *stamp = s->mark + (size_t)omp_get_thread_num() * 3 * (size_t)m, *slot = stamp + m;
+        for (int b = 0; b < m; b++)
+            stamp[b] = -1;
+#pragma omp for schedule(static)
+        for (int c = 0; c < ncols; c++) {
+            const int a = rows ? cols[c] : c;
+            coarse_column(s, a, stamp, slot, ei + ep[a], ex + ep[a]);
+        }
+    }
+    return coarse_numeric(s, err);
+}
+
+/* E from (A Z)^T, its analysis and its factor */
 static enum mps_status coarse_factor(struct fluid_defl *s, int n, struct mps_err *err)
 {
     enum mps_status rc = MPS_OK;
     const int m = s->nagg;
     cholmod_common *cm = &s->cm;
+    cholmod_free_sparse(&s->E, cm);
+    cholmod_free_factor(&s->Lc, cm);
     cholmod_sparse *E = coarse_matrix(s, n, err, &rc);
     if (!E)
         return rc;
-    cholmod_free_factor(&s->Lc, cm);
     int bw = 0; /* E's half bandwidth: column a's rows are sorted, the first is the farthest */
     for (int a = 0; a < m; a++) {
         const int *ep = E->p, *ei = E->i;
@@ -416,25 +512,15 @@ static enum mps_status coarse_factor(struct fluid_defl *s, int n, struct mps_err
             bw = a - ei[ep[a]];
     }
     cm->method[0].ordering = bw <= NATURAL_MAX_BW ? CHOLMOD_NATURAL : CHOLMOD_AMD;
+    s->E = E;
     s->Lc = cholmod_analyze(E, cm);
-    int ok = s->Lc && cm->status >= CHOLMOD_OK;
-    if (ok)
-        ok = cholmod_factorize(E, s->Lc, cm) && cm->status >= CHOLMOD_OK;
-    int notpd = cm->status == CHOLMOD_NOT_POSDEF;
-    cholmod_free_sparse(&E, cm);
-    if (!ok || notpd) {
-        if (notpd)
-            rc = mps_err_set(err, MPS_ESOLVE,
-                             "pcg_defl: the coarse matrix Z^T A Z (%d aggregates) is not positive "
-                             "definite: A is not, or an aggregate has no row",
-                             m);
-        else
-            rc = coarse_fail(s, !s->Lc ? "cholmod_analyze" : "cholmod_factorize", err);
+    if (!s->Lc || cm->status < CHOLMOD_OK) {
+        rc = coarse_fail(s, "cholmod_analyze", err);
         cholmod_free_factor(&s->Lc, cm);
+        cholmod_free_sparse(&s->E, cm);
         return rc;
     }
-    s->coarse_n = m;
-    return MPS_OK;
+    return coarse_numeric(s, err);
 }
 
 /* mu = E^-1 (Z^T v) (with_az = 0) or E^-1 ((A Z)^T v) (with_az = 1), into

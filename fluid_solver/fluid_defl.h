@@ -27,11 +27,16 @@ enum mps_status fluid_defl_set_aggregates(struct fluid_defl *d, const int *agg, 
 /* A Z, E and E's factor for matrix A. An empty aggregate (or an A that is not
  * positive definite) is reported as MPS_ESOLVE. same_pattern: A has the
  * pattern (rowptr, col) of the last set-up's matrix and the aggregates are
- * the same array: A Z's lists are refilled with the new values (the same
- * numbers a full set-up gives, for a third of its cost); without a last
- * set-up of that size and those aggregates, a full one. */
+ * the same array: A Z's lists are refilled with the new values and E's
+ * factor is computed again on its kept analysis (the same numbers a full
+ * set-up gives, for a third of its cost); without a last set-up of that
+ * size and those aggregates, a full one. rows (with same_pattern; NULL:
+ * all): the nrows rows whose values differ from the last set-up's matrix
+ * (an entry A_ij that changed lists both i and j); only they, and E's
+ * columns they touch, are refilled. */
 enum mps_status fluid_defl_setup(struct fluid_defl *d, const struct fluid_csr *A,
-                                 int same_pattern, struct mps_err *err);
+                                 int same_pattern, const int *rows, int nrows,
+                                 struct mps_err *err);
 
 /* x += Z c, r -= A Z c with c = E^-1 Z^T r, so that Z^T r = 0; r.r in *rr. */
 enum mps_status fluid_defl_start(struct fluid_defl *d, const struct fluid_csr *A, double *x,

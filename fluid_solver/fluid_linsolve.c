@@ -89,6 +89,10 @@ struct fluid_linsolve {
     int nthreads;        /* resolved: > 0 */
     int trusted;         /* structure well formed by construction: no check_input */
     int same_pattern;    /* the next solve's A: the last one's pattern (one solve) */
+    const int *changed_rows;   /* ... and only these rows' values changed (one solve) */
+    int nchanged;
+    int setup_current;   /* the last solve set up for its A (diag, dinv, coarse space) */
+    int setup_n;         /* ... of this many rows */
 
     /* PCG work vectors, capacity cap_n */
     size_t cap_n;
@@ -322,6 +326,13 @@ void fluid_linsolve_trust_structure(struct fluid_linsolve *s, int trusted)
 void fluid_linsolve_same_pattern(struct fluid_linsolve *s)
 {
     s->same_pattern = 1;
+}
+
+void fluid_linsolve_changed_rows(struct fluid_linsolve *s, const int *rows, int nrows)
+{
+    s->same_pattern = 1;
+    s->changed_rows = rows;
+    s->nchanged = nrows;
 }
 
 enum mps_status fluid_linsolve_set_drop(struct fluid_linsolve *s, double theta,
@@ -898,6 +909,8 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
                                  s->ops->name);
     }
     double bnorm = sqrt(rb[1]);
+    const int was_current = s->setup_current && s->setup_n == n;
+    s->setup_current = 0; /* until this solve's set-up is done */
     if (bnorm == 0.0) {   /* b = 0: x = 0 exactly, no iteration */
         memset(x, 0, (size_t)n * sizeof *x);
         st->residual = 0.0;
@@ -912,18 +925,32 @@ static enum mps_status pcg(struct fluid_linsolve *s, const struct fluid_csr *A, 
     }
 
     double t1 = omp_get_wtime();
+    /* the last solve's set-up, for the rows that changed since (the
+     * pattern, so the diagonal's places, is the same) */
+    const int *rows = s->same_pattern && was_current && s->changed_rows &&
+                              !s->ops->precond_setup
+                          ? s->changed_rows
+                          : NULL;
+    if (rows) {
+        for (int k = 0; k < s->nchanged; k++)
+            s->dinv[rows[k]] = 1.0 / A->val[s->diag[rows[k]]];
+    } else {
 #pragma omp parallel for num_threads(s->nthreads) if (n >= PAR_MIN_ROWS) schedule(static)
-    for (int i = 0; i < n; i++) {
-        int k = A->rowptr[i];
-        while (A->col[k] != i)   /* check_input guarantees it is there */
-            k++;
-        s->diag[i] = k;
-        s->dinv[i] = 1.0 / A->val[k];
+        for (int i = 0; i < n; i++) {
+            int k = A->rowptr[i];
+            while (A->col[k] != i) /* check_input guarantees it is there */
+                k++;
+            s->diag[i] = k;
+            s->dinv[i] = 1.0 / A->val[k];
+        }
     }
     if (s->ops->precond_setup && (rc = s->ops->precond_setup(s, A, err)))
         return rc;
-    if (s->defl && (rc = fluid_defl_setup(s->defl, A, s->same_pattern, err)))
+    if (s->defl && (rc = fluid_defl_setup(s->defl, A, s->same_pattern && was_current,
+                                          rows, s->nchanged, err)))
         return rc;
+    s->setup_current = 1;
+    s->setup_n = n;
     double t2 = omp_get_wtime();
     st->t_factor = t2 - t1;
 
@@ -1181,9 +1208,14 @@ enum mps_status fluid_linsolve_solve(struct fluid_linsolve *s, const struct flui
         check_input(s, A, b, iterative ? x : NULL, !(iterative && s->trusted), err);
     if (rc || A->n == 0) {
         s->same_pattern = 0;
+        s->changed_rows = NULL;
+        s->setup_current = 0;
         return rc;
     }
     rc = s->ops->solve(s, A, b, x, st, err);
     s->same_pattern = 0;
+    s->changed_rows = NULL;
+    if (rc)
+        s->setup_current = 0;
     return rc;
 }

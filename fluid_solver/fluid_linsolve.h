@@ -77,6 +77,17 @@ void fluid_linsolve_trust_structure(struct fluid_linsolve *s, int trusted);
  * building them (the same numbers, to the bit). Holds for one solve. */
 void fluid_linsolve_same_pattern(struct fluid_linsolve *s);
 
+/* As fluid_linsolve_same_pattern, and the next solve's matrix differs from
+ * the last solve's only in the values of these rows (an entry A_ij that
+ * changed lists both i and j; the release of held PPE rows changes a
+ * handful of rows and their neighbours). The PCG methods without a
+ * factored preconditioner then keep Jacobi's diagonal but for those rows,
+ * and pcg_defl refills only the coarse entries they touch: the same
+ * numbers, to the bit, as a full set-up. If the last solve did not set up
+ * (its start was already converged, or it failed), a full set-up. rows:
+ * borrowed until that solve. Holds for one solve. */
+void fluid_linsolve_changed_rows(struct fluid_linsolve *s, const int *rows, int nrows);
+
 /* Solves A x = b. On entry x holds the initial guess (iterative methods start
  * from it: warm start from the previous step's pressure); on exit the
  * solution. */

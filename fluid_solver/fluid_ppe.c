@@ -527,7 +527,8 @@ static int grow_held_rows(struct fluid *f, size_t need)
     const size_t c = need + need / 2 + 16;
     int fail = 0;
     f->rhs_assembled = mps_realloc_or_flag(f->rhs_assembled, c, sizeof(double), &fail);
-    f->row_local = mps_realloc_or_flag(f->row_local, c, sizeof(int), &fail);
+    f->row_list = mps_realloc_or_flag(f->row_list, c, sizeof(int), &fail);
+    f->row_touched = mps_realloc_or_flag(f->row_touched, c, 1, &fail);
     f->row_is_fluid = mps_realloc_or_flag(f->row_is_fluid, c, 1, &fail);
     f->row_held = mps_realloc_or_flag(f->row_held, c, 1, &fail);
     f->row_held_next = mps_realloc_or_flag(f->row_held_next, c, 1, &fail);
@@ -553,7 +554,7 @@ static int held_start_sweeps(struct fluid *f, const unsigned char *is_fluid, uns
                              unsigned char *mark)
 {
     const int nr = f->nrows;
-    int *local = f->row_local, nlocal = 0;
+    int *local = f->row_list, nlocal = 0;
     memset(mark, 0, (size_t)nr);
     for (int r = 0; r < nr; r++)
         if (held[r]) {
@@ -605,6 +606,28 @@ static int held_start_sweeps(struct fluid *f, const unsigned char *is_fluid, uns
     return nheld;
 }
 
+/* The rows whose matrix values change when the rows with now[r] != was[r]
+ * (was = NULL: all clear) change between held and not: those rows and
+ * their neighbours, the pattern being symmetric. Into f->row_list in row
+ * order; returns how many. */
+static int rows_touched(struct fluid *f, const unsigned char *now, const unsigned char *was)
+{
+    const int nr = f->nrows;
+    unsigned char *touched = f->row_touched;
+    memset(touched, 0, (size_t)nr);
+    for (int r = 0; r < nr; r++)
+        if (now[r] != (was ? was[r] : 0)) {
+            touched[r] = 1;
+            for (int e = f->rowptr[r]; e < f->rowptr[r + 1]; e++)
+                touched[f->col[e]] = 1;
+        }
+    int n = 0;
+    for (int r = 0; r < nr; r++)
+        if (touched[r])
+            f->row_list[n++] = r;
+    return n;
+}
+
 /* Water holds no tension (fluid.tension_solves). Clamping the solution
  * after one solve leaves each row next to a negative one with the pressure
  * computed against that negative value, too low: in the 4 mm dam break's
@@ -646,20 +669,24 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
     struct fluid_csr A = {nr, f->rowptr, f->col, f->val};
     enum mps_status st = MPS_OK;
     int solves = 0, changed = 1;
+    int nlist = rows_touched(f, held, NULL);
     while (changed && solves < f->prm.tension_solves) {
-        /* a held row keeps its diagonal and rhs 0, so its solution is 0 */
+        /* a held row keeps its diagonal and rhs 0, so its solution is 0;
+         * only the rows the last change of the set touched are rewritten */
+        const int *list = f->row_list;
 #pragma omp parallel for schedule(static)
-        for (int r = 0; r < nr; r++) {
+        for (int k = 0; k < nlist; k++) {
+            const int r = list[k];
             f->rhs[r] = held[r] ? 0.0 : rhs0[r];
-            for (int k = f->rowptr[r]; k < f->rowptr[r + 1]; k++) {
-                int q = f->col[k];
-                f->val[k] = (q != r && (held[r] || held[q])) ? 0.0 : val0[k];
+            for (int e = f->rowptr[r]; e < f->rowptr[r + 1]; e++) {
+                int q = f->col[e];
+                f->val[e] = (q != r && (held[r] || held[q])) ? 0.0 : val0[e];
             }
             if (held[r])
                 f->sol[r] = 0.0;
         }
         struct fluid_linsolve_stats ls;
-        fluid_linsolve_same_pattern(f->ls); /* held rows keep their zeros */
+        fluid_linsolve_changed_rows(f->ls, list, nlist); /* held rows keep their zeros */
         st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, &ls, err);
         if (st) {
             mps_err_prefix(err, "PPE at t = %.6g s, solve %d with %d rows under tension held "
@@ -688,6 +715,8 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
             changed |= next[r] != held[r];
             nheld += next[r];
         }
+        if (changed)
+            nlist = rows_touched(f, next, held);
         unsigned char *t = held;
         held = next;
         next = t;

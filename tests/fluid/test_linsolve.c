@@ -698,6 +698,156 @@ static void test_deflation_same_pattern(void)
     mat_free(&m2);
 }
 
+/* The assembled matrix val0 / rhs b0 with the rows flagged in held
+ * decoupled (couplings and rhs 0, diagonal kept: fluid.tension_solves), the
+ * diagonal of the rows flagged in scale_diag times 1.25, all times `factor`. */
+static void hold_rows(struct mat *m, const double *val0, const double *b0,
+                      const unsigned char *held, const unsigned char *scale_diag, double factor,
+                      double *b)
+{
+    for (int i = 0; i < m->n; i++) {
+        b[i] = factor * (held[i] ? 0.0 : b0[i]);
+        for (int k = m->rowptr[i]; k < m->rowptr[i + 1]; k++) {
+            const int j = m->col[k];
+            double v = (j != i && (held[i] || held[j])) ? 0.0 : val0[k];
+            if (j == i && scale_diag && scale_diag[i])
+                v *= 1.25;
+            m->val[k] = factor * v;
+        }
+    }
+}
+
+/* The rows whose values differ between held sets now and was (NULL: none
+ * held): the rows that changed and their neighbours; into list. */
+static int touched_rows(const struct mat *m, const unsigned char *now, const unsigned char *was,
+                        unsigned char *mark, int *list)
+{
+    memset(mark, 0, (size_t)m->n);
+    for (int i = 0; i < m->n; i++)
+        if (now[i] != (was ? was[i] : 0))
+            for (int k = m->rowptr[i]; k < m->rowptr[i + 1]; k++)
+                mark[i] = mark[m->col[k]] = 1;
+    int n = 0;
+    for (int i = 0; i < m->n; i++)
+        if (mark[i])
+            list[n++] = i;
+    return n;
+}
+
+/* Solves (A, b) from x_start with a solver set up from nothing and checks
+ * that the solve s just made into xs is the same to the bit. */
+static void check_as_fresh(const char *method, const struct mat *m, const int *agg, int nagg,
+                           const double *b, const double *x_start, const double *xs,
+                           const struct fluid_linsolve_stats *sts, const char *what)
+{
+    struct fluid_linsolve *fresh = NULL;
+    struct mps_err err = {0};
+    struct fluid_linsolve_stats stf;
+    double *xf = malloc((size_t)m->n * sizeof *xf);
+    memcpy(xf, x_start, (size_t)m->n * sizeof *xf);
+    CHECK(fluid_linsolve_create(&fresh, method, 1e-8, 1000, 0, &err) == MPS_OK);
+    CHECK(fluid_linsolve_set_aggregates(fresh, agg, m->n, nagg, &err) == MPS_OK);
+    CHECK(fluid_linsolve_solve(fresh, &m->csr, b, xf, &stf, &err) == MPS_OK);
+    printf("  %s, %s: %d iterations after the partial refill, %d from nothing\n", method, what,
+           sts->iterations, stf.iterations);
+    CHECK(sts->iterations > 0);
+    CHECK(sts->iterations == stf.iterations);
+    CHECK(memcmp(xs, xf, (size_t)m->n * sizeof *xf) == 0);
+    CHECK(relres(&m->csr, b, xs) <= 1e-8);
+    fluid_linsolve_destroy(&fresh);
+    free(xf);
+}
+
+/* fluid_linsolve_changed_rows: rows held and let go as the no-tension PPE
+ * does, the solver told which rows changed. Each solve must be, to the bit,
+ * what a solver set up from nothing gives: a refill that misses a coarse
+ * column the rows touch, keeps a stale Jacobi diagonal, or builds on a
+ * set-up older than the last solve (one that skipped it, its start being
+ * converged) gives other iterates. */
+static void test_changed_rows(void)
+{
+    const int nx = 40, ny = 41;
+    const char *kinds[] = {"pcg_defl", "pcg_jacobi"};
+    for (int mi = 0; mi < 2; mi++) {
+        struct mat m;
+        build(&m, nx, ny, 0.1, 0.0, 1e-4);
+        const int n = m.n;
+        const size_t nnz = (size_t)m.rowptr[n];
+        double *b0 = make_rhs(&m, ny), *b = malloc((size_t)n * sizeof *b);
+        double *val0 = malloc(nnz * sizeof *val0), *x = calloc((size_t)n, sizeof *x);
+        double *x_start = malloc((size_t)n * sizeof *x_start);
+        memcpy(val0, m.val, nnz * sizeof *val0);
+        unsigned char *h1 = calloc((size_t)n, 1), *h2 = calloc((size_t)n, 1);
+        unsigned char *h3 = calloc((size_t)n, 1), *mark = malloc((size_t)n);
+        unsigned char *diag1 = malloc((size_t)n);
+        int *list = malloc((size_t)n * sizeof *list), nagg;
+        int *agg = square_aggregates(n, nx, 4, &nagg);
+        struct fluid_linsolve *s = NULL;
+        struct mps_err err = {0};
+        struct fluid_linsolve_stats st;
+        CHECK(fluid_linsolve_create(&s, kinds[mi], 1e-8, 1000, 0, &err) == MPS_OK);
+        CHECK(fluid_linsolve_set_aggregates(s, agg, n, nagg, &err) == MPS_OK);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b0, x, &st, &err) == MPS_OK);
+        /* 1: hold every 7th row of the lower half; the listed rows' diagonal
+         * changes too (the promise is only that the other rows stay) */
+        for (int i = 0; i < n / 2; i += 7)
+            h1[i] = 1;
+        int nl = touched_rows(&m, h1, NULL, diag1, list);
+        hold_rows(&m, val0, b0, h1, diag1, 1.0, b);
+        for (int i = 0; i < n; i++)
+            x[i] = h1[i] ? 0.0 : x[i];
+        memcpy(x_start, x, (size_t)n * sizeof *x);
+        fluid_linsolve_changed_rows(s, list, nl);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        check_as_fresh(kinds[mi], &m, agg, nagg, b, x_start, x, &st, "rows held");
+        /* 2: let every other held row go, hold some of the upper half */
+        memcpy(h2, h1, (size_t)n);
+        for (int i = 0, k = 0; i < n / 2; i += 7, k++)
+            h2[i] = k % 2;
+        for (int i = n / 2; i < n; i += 11)
+            h2[i] = 1;
+        nl = touched_rows(&m, h2, h1, mark, list);
+        hold_rows(&m, val0, b0, h2, diag1, 1.0, b);
+        for (int i = 0; i < n; i++)
+            x[i] = h2[i] ? 0.0 : x[i];
+        memcpy(x_start, x, (size_t)n * sizeof *x);
+        fluid_linsolve_changed_rows(s, list, nl);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        check_as_fresh(kinds[mi], &m, agg, nagg, b, x_start, x, &st, "rows let go and held");
+        /* 3: the same system times 2 from its solution: converged at the
+         * start, so no set-up; the next changed rows are relative to it */
+        hold_rows(&m, val0, b0, h2, diag1, 2.0, b);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        CHECK(st.iterations == 0);
+        memcpy(h3, h2, (size_t)n);
+        for (int i = 3; i < n; i += 13)
+            h3[i] = 1;
+        nl = touched_rows(&m, h3, h2, mark, list);
+        hold_rows(&m, val0, b0, h3, diag1, 2.0, b);
+        for (int i = 0; i < n; i++)
+            x[i] = h3[i] ? 0.0 : x[i];
+        memcpy(x_start, x, (size_t)n * sizeof *x);
+        fluid_linsolve_changed_rows(s, list, nl);
+        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
+        check_as_fresh(kinds[mi], &m, agg, nagg, b, x_start, x, &st,
+                       "after a solve that skipped its set-up");
+        fluid_linsolve_destroy(&s);
+        free(b0);
+        free(b);
+        free(val0);
+        free(x);
+        free(x_start);
+        free(h1);
+        free(h2);
+        free(h3);
+        free(mark);
+        free(diag1);
+        free(list);
+        free(agg);
+        mat_free(&m);
+    }
+}
+
 static void test_zero_rhs(void)
 {
     struct mat m;
@@ -824,6 +974,7 @@ int main(void)
     test_deflation_coarse_orders();
     test_deflation_exact_start();
     test_deflation_same_pattern();
+    test_changed_rows();
     test_zero_rhs();
     test_errors();
     return test_summary("test_linsolve");
