@@ -734,26 +734,32 @@ static int touched_rows(const struct mat *m, const unsigned char *now, const uns
     return n;
 }
 
-/* Solves (A, b) from x_start with a solver set up from nothing and checks
- * that the solve s just made into xs is the same to the bit. */
-static void check_as_fresh(const char *method, const struct mat *m, const int *agg, int nagg,
-                           const double *b, const double *x_start, const double *xs,
-                           const struct fluid_linsolve_stats *sts, const char *what)
+/* x's held rows set to 0, then (A, b) solved from there by s, told of the
+ * nl changed rows in list, and by a solver set up from nothing: the two
+ * must be the same to the bit. */
+static void resolve_as_fresh(const char *method, struct fluid_linsolve *s, const struct mat *m,
+                             const int *agg, int nagg, const double *b,
+                             const unsigned char *held, const int *list, int nl, double *x,
+                             const char *what)
 {
     struct fluid_linsolve *fresh = NULL;
     struct mps_err err = {0};
-    struct fluid_linsolve_stats stf;
+    struct fluid_linsolve_stats sts, stf;
     double *xf = malloc((size_t)m->n * sizeof *xf);
-    memcpy(xf, x_start, (size_t)m->n * sizeof *xf);
+    for (int i = 0; i < m->n; i++)
+        x[i] = held[i] ? 0.0 : x[i];
+    memcpy(xf, x, (size_t)m->n * sizeof *xf);
+    fluid_linsolve_changed_rows(s, list, nl);
+    CHECK(fluid_linsolve_solve(s, &m->csr, b, x, &sts, &err) == MPS_OK);
     CHECK(fluid_linsolve_create(&fresh, method, 1e-8, 1000, 0, &err) == MPS_OK);
     CHECK(fluid_linsolve_set_aggregates(fresh, agg, m->n, nagg, &err) == MPS_OK);
     CHECK(fluid_linsolve_solve(fresh, &m->csr, b, xf, &stf, &err) == MPS_OK);
     printf("  %s, %s: %d iterations after the partial refill, %d from nothing\n", method, what,
-           sts->iterations, stf.iterations);
-    CHECK(sts->iterations > 0);
-    CHECK(sts->iterations == stf.iterations);
-    CHECK(memcmp(xs, xf, (size_t)m->n * sizeof *xf) == 0);
-    CHECK(relres(&m->csr, b, xs) <= 1e-8);
+           sts.iterations, stf.iterations);
+    CHECK(sts.iterations > 0);
+    CHECK(sts.iterations == stf.iterations);
+    CHECK(memcmp(x, xf, (size_t)m->n * sizeof *xf) == 0);
+    CHECK(relres(&m->csr, b, x) <= 1e-8);
     fluid_linsolve_destroy(&fresh);
     free(xf);
 }
@@ -775,7 +781,6 @@ static void test_changed_rows(void)
         const size_t nnz = (size_t)m.rowptr[n];
         double *b0 = make_rhs(&m, ny), *b = malloc((size_t)n * sizeof *b);
         double *val0 = malloc(nnz * sizeof *val0), *x = calloc((size_t)n, sizeof *x);
-        double *x_start = malloc((size_t)n * sizeof *x_start);
         memcpy(val0, m.val, nnz * sizeof *val0);
         unsigned char *h1 = calloc((size_t)n, 1), *h2 = calloc((size_t)n, 1);
         unsigned char *h3 = calloc((size_t)n, 1), *mark = malloc((size_t)n);
@@ -794,12 +799,7 @@ static void test_changed_rows(void)
             h1[i] = 1;
         int nl = touched_rows(&m, h1, NULL, diag1, list);
         hold_rows(&m, val0, b0, h1, diag1, 1.0, b);
-        for (int i = 0; i < n; i++)
-            x[i] = h1[i] ? 0.0 : x[i];
-        memcpy(x_start, x, (size_t)n * sizeof *x);
-        fluid_linsolve_changed_rows(s, list, nl);
-        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
-        check_as_fresh(kinds[mi], &m, agg, nagg, b, x_start, x, &st, "rows held");
+        resolve_as_fresh(kinds[mi], s, &m, agg, nagg, b, h1, list, nl, x, "rows held");
         /* 2: let every other held row go, hold some of the upper half */
         memcpy(h2, h1, (size_t)n);
         for (int i = 0, k = 0; i < n / 2; i += 7, k++)
@@ -808,12 +808,8 @@ static void test_changed_rows(void)
             h2[i] = 1;
         nl = touched_rows(&m, h2, h1, mark, list);
         hold_rows(&m, val0, b0, h2, diag1, 1.0, b);
-        for (int i = 0; i < n; i++)
-            x[i] = h2[i] ? 0.0 : x[i];
-        memcpy(x_start, x, (size_t)n * sizeof *x);
-        fluid_linsolve_changed_rows(s, list, nl);
-        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
-        check_as_fresh(kinds[mi], &m, agg, nagg, b, x_start, x, &st, "rows let go and held");
+        resolve_as_fresh(kinds[mi], s, &m, agg, nagg, b, h2, list, nl, x,
+                         "rows let go and held");
         /* 3: the same system times 2 from its solution: converged at the
          * start, so no set-up; the next changed rows are relative to it */
         hold_rows(&m, val0, b0, h2, diag1, 2.0, b);
@@ -824,19 +820,13 @@ static void test_changed_rows(void)
             h3[i] = 1;
         nl = touched_rows(&m, h3, h2, mark, list);
         hold_rows(&m, val0, b0, h3, diag1, 2.0, b);
-        for (int i = 0; i < n; i++)
-            x[i] = h3[i] ? 0.0 : x[i];
-        memcpy(x_start, x, (size_t)n * sizeof *x);
-        fluid_linsolve_changed_rows(s, list, nl);
-        CHECK(fluid_linsolve_solve(s, &m.csr, b, x, &st, &err) == MPS_OK);
-        check_as_fresh(kinds[mi], &m, agg, nagg, b, x_start, x, &st,
-                       "after a solve that skipped its set-up");
+        resolve_as_fresh(kinds[mi], s, &m, agg, nagg, b, h3, list, nl, x,
+                         "after a solve that skipped its set-up");
         fluid_linsolve_destroy(&s);
         free(b0);
         free(b);
         free(val0);
         free(x);
-        free(x_start);
         free(h1);
         free(h2);
         free(h3);
