@@ -296,10 +296,10 @@ void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const do
 }
 
 void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f)[MPS_DIM],
-                        double *div)
+                        double r_floor, double *div)
 {
     const struct mps_nbr_list *nl = in->nl;
-    const double re2 = in->re * in->re, coef = MPS_DIM / n0;
+    const double re2 = in->re * in->re, coef = MPS_DIM / n0, rf2 = r_floor * r_floor;
 #pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
     for (size_t i = 0; i < nl->n; i++) {
         if (!QUERY(in, i))
@@ -318,6 +318,10 @@ void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f
                 continue;
             for (int d = 0; d < MPS_DIM; d++)
                 dot += (f[j][d] - f[i][d]) * dx[d];
+            if (r2 < rf2) {
+                acc += dot * mps_divergence_floor_factor(r2, in->re, r_floor);
+                continue;
+            }
             double ir = 1.0 / sqrt(r2); /* one division, as in grad_sums */
             acc += dot * ((in->re * ir - 1.0) * ir * ir);
         }

@@ -53,8 +53,10 @@ void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const do
                                 int use_min, double cond_floor, double (*grad)[MPS_DIM],
                                 unsigned char *fallback);
 
-/* Eq. 10: div_i = d/n0 sum_j (f_j - f_i).r_ij / |r_ij|^2 w(r_ij). */
+/* Eq. 10: div_i = d/n0 sum_j (f_j - f_i).r_ij / |r_ij|^2 w(r_ij), a pair
+ * closer than r_floor (m; 0: none) read at r_floor
+ * (mps_divergence_floor_factor). */
 void mps_ops_divergence(const struct mps_ops_in *in, double n0, const double (*f)[MPS_DIM],
-                        double *div);
+                        double r_floor, double *div);
 
 #endif

@@ -568,6 +568,7 @@ void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows)
 {
     const struct fluid_params *p = &f->prm;
     const double re = p->re_n * p->dp, re2 = re * re, coef = MPS_DIM / f->n0;
+    const double rf = p->divergence_floor * p->dp, rf2 = rf * rf;
     const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
     const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
 #pragma omp parallel for schedule(dynamic, MPS_OMP_ROW_CHUNK)
@@ -607,7 +608,10 @@ void fluid_divergence_slip_walls(struct fluid *f, const unsigned char *rows)
             double dv = 0.0;
             for (int d = 0; d < MPS_DIM; d++)
                 dv += rel[d] * dx[d];
-            acc += (re / sqrt(r2) - 1.0) * dv / r2;
+            if (r2 < rf2)
+                acc += mps_divergence_floor_factor(r2, re, rf) * dv;
+            else
+                acc += (re / sqrt(r2) - 1.0) * dv / r2;
         }
         f->div[i] = coef * acc;
     }
@@ -813,7 +817,8 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
             fluid_divergence_slip_walls(f, rows);
         } else if (!p->divergence_wide) {
             struct mps_ops_in dv_in = {&f->nl_n, x, p->re_n * p->dp, NULL, rows, NULL};
-            mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar, f->div);
+            mps_ops_divergence(&dv_in, f->n0, (const double(*)[MPS_DIM])f->vstar,
+                               p->divergence_floor * p->dp, f->div);
         }
     }
 

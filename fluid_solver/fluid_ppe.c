@@ -210,13 +210,17 @@ static int row_weights(struct fluid *f, size_t i, double c, int wide, double *di
 }
 
 /* Eq. 10's sum over row i's kept Laplacian pairs (wcol, wlap of pass 1):
- * sum_j c w_ij (v*_j - v*_i).r_ij / r_ij^2. A second sweep of the row's
- * pairs, taken only by the rows that need it (fluid.divergence_stencil). */
+ * sum_j c w_ij (v*_j - v*_i).r_ij / r_ij^2, a pair closer than
+ * fluid.divergence_floor read there (c w_ij rescaled to the floor's
+ * weight). A second sweep of the row's pairs, taken only by the rows that
+ * need it (fluid.divergence_stencil). */
 static double row_divergence_sum(const struct fluid *f, size_t i)
 {
     const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
     const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
     const size_t k0 = f->nl.start[i];
+    const double re = f->prm.re_lap * f->prm.dp;
+    const double rf = f->prm.divergence_floor * f->prm.dp, rf2 = rf * rf;
     double dsum = 0.0;
     for (size_t k = k0; k < k0 + (size_t)f->nwlap[i]; k++) {
         const int j = f->wcol[k];
@@ -226,7 +230,10 @@ static double row_divergence_sum(const struct fluid *f, size_t i)
             r2 += dx * dx;
             dv += (vs[j][d] - vs[i][d]) * dx;
         }
-        dsum += r2 > 0.0 ? f->wlap[k] * dv / r2 : 0.0;
+        if (r2 > 0.0 && r2 < rf2) /* wlap = c w(r): c times the floor's factor */
+            dsum += f->wlap[k] / (re / sqrt(r2) - 1.0) * mps_divergence_floor_factor(r2, re, rf) * dv;
+        else
+            dsum += r2 > 0.0 ? f->wlap[k] * dv / r2 : 0.0;
     }
     return dsum;
 }

@@ -1268,7 +1268,8 @@ static void test_divergence_stencil(void)
     const struct fluid_params *p = &f->prm;
     struct mps_ops_in in = {&f->nl, (const double(*)[MPS_DIM])f->x, p->re_lap * p->dp, NULL,
                             f->unknown, NULL};
-    mps_ops_divergence(&in, f->n0_lap, (const double(*)[MPS_DIM])f->vstar, want);
+    mps_ops_divergence(&in, f->n0_lap, (const double(*)[MPS_DIM])f->vstar,
+                       p->divergence_floor * p->dp, want);
     double worst = 0.0, big = 0.0;
     int rows = 0;
     for (size_t i = 0; i < n; i++)
@@ -1327,7 +1328,8 @@ static void test_divergence_near_bodies(void)
     const struct fluid_params *p = &f->prm;
     struct mps_ops_in in = {&f->nl, (const double(*)[MPS_DIM])f->x, p->re_lap * p->dp, NULL,
                             f->unknown, NULL};
-    mps_ops_divergence(&in, f->n0_lap, (const double(*)[MPS_DIM])f->vstar, wide);
+    mps_ops_divergence(&in, f->n0_lap, (const double(*)[MPS_DIM])f->vstar,
+                       p->divergence_floor * p->dp, wide);
     CHECK(fluid_ppe_assemble(f, 1e-3, &err) == MPS_OK);
     const double re2 = pow(p->re_lap * p->dp, 2);
     int near = 0, far = 0, near_differs = 0;
@@ -1361,6 +1363,118 @@ static void test_divergence_near_bodies(void)
     fluid_destroy(&f);
 }
 
+/* fluid.divergence_floor (0.5 dp, the default) on the solver's three paths
+ * of Eq. 10: the 2 cm dam break after 5 steps, the nearest fluid neighbour
+ * of a particle in the column's middle moved to 0.3 dp of it along their
+ * line and closing on it at 1 m/s, beside a smooth field. The pair's rows
+ * must differ from Eq. 10 as printed (mps_ops_divergence without the floor)
+ * by exactly its term read at the floor, w(r_f) / (r_f r) for w(r) / r^2,
+ * and no other row may change; away from the walls the slipping path (the
+ * default) must read what mps_ops_divergence reads with the floor, and the
+ * assembly's rows on the Laplacian's stencil what it reads at re_lap. */
+static void test_divergence_floor(void)
+{
+    const char *sets[] = {"dp=0.02", "fluid.divergence_stencil=laplacian"};
+    struct fluid *f = make_stepped("cases/dambreak/case.yml", sets, 2, 5);
+    if (!f)
+        return;
+    const struct fluid_params *p = &f->prm;
+    const size_t n = f->ps.n;
+    const double dt = 1e-3, rf = p->divergence_floor * p->dp, re = p->re_n * p->dp;
+    CHECK(p->divergence_floor == 0.5);
+    const size_t i = nearest_fluid(f, 0.073, 0.146);
+    size_t j = i;
+    double best = INFINITY;
+    for (size_t k = 0; k < f->nfluid; k++) {
+        double d2 = pow(f->x[k][0] - f->x[i][0], 2) + pow(f->x[k][1] - f->x[i][1], 2);
+        if (k != i && d2 < best) {
+            best = d2;
+            j = k;
+        }
+    }
+    const double r = 0.3 * p->dp;
+    double e[MPS_DIM];
+    for (int d = 0; d < MPS_DIM; d++) {
+        e[d] = (f->x[j][d] - f->x[i][d]) / sqrt(best);
+        f->x[j][d] = f->x[i][d] + r * e[d];
+    }
+    struct mps_err err = {0};
+    CHECK(mps_nbr_list_filter(&f->nl_n, &f->nl, (const double(*)[MPS_DIM])f->x, re, &err) ==
+          MPS_OK);
+    for (size_t k = 0; k < n; k++) {
+        double x = f->x[k][0], y = f->x[k][1];
+        f->vstar[k][0] = k < f->nfluid ? 0.7 * x + 0.3 * y + 0.01 * sin(1e3 * x * y + (double)k) : 0.0;
+        f->vstar[k][1] = k < f->nfluid ? -0.2 * x + 0.4 * y + 0.01 * cos(7e2 * x + (double)k) : 0.0;
+    }
+    for (int d = 0; d < MPS_DIM; d++)
+        f->vstar[j][d] -= 1.0 * e[d];
+    double *floored = calloc(n, sizeof *floored), *plain = calloc(n, sizeof *plain);
+    CHECK(floored && plain);
+    if (!floored || !plain) {
+        free(floored);
+        free(plain);
+        fluid_destroy(&f);
+        return;
+    }
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
+    const double(*vs)[MPS_DIM] = (const double(*)[MPS_DIM])f->vstar;
+
+    /* the floor in mps_ops_divergence: the pair's rows, and no other */
+    struct mps_ops_in in_n = {&f->nl_n, x, re, NULL, f->is_fluid, NULL};
+    mps_ops_divergence(&in_n, f->n0, vs, rf, floored);
+    mps_ops_divergence(&in_n, f->n0, vs, 0.0, plain);
+    double dot = 0.0;
+    for (int d = 0; d < MPS_DIM; d++)
+        dot += (vs[j][d] - vs[i][d]) * (x[j][d] - x[i][d]);
+    const double term_plain = MPS_DIM / f->n0 * (re / r - 1.0) / (r * r) * dot,
+                 term_floor = MPS_DIM / f->n0 * (re / rf - 1.0) / (rf * r) * dot;
+    int changed = 0;
+    for (size_t k = 0; k < f->nfluid; k++)
+        changed += floored[k] != plain[k];
+    printf("Eq. 10 floor: a pair at 0.30 dp closing at %.3g m/s; row i %.6g 1/s (%.6g as "
+           "printed), row j %.6g (%.6g); the pair's term %.6g read at the floor %.6g; %d rows "
+           "changed\n", -dot / r, floored[i], plain[i], floored[j], plain[j], term_plain,
+           term_floor, changed);
+    CHECK(changed == 2 && dot < 0.0);
+    CHECK_NEAR(floored[i] - plain[i], term_floor - term_plain, 1e-9 * fabs(term_plain));
+    CHECK_NEAR(floored[j] - plain[j], term_floor - term_plain, 1e-9 * fabs(term_plain));
+
+    /* the walls slipping (the default path): the same away from the walls */
+    fluid_divergence_slip_walls(f, f->is_fluid);
+    double worst = 0.0, big = 0.0;
+    int far = 0;
+    for (size_t k = 0; k < f->nfluid; k++) {
+        double xk = f->x[k][0], yk = f->x[k][1];
+        if (xk < re + p->dp || xk > p->tank_w - re - p->dp || yk < re + p->dp)
+            continue;
+        far++;
+        worst = fmax(worst, fabs(f->div[k] - floored[k]));
+        big = fmax(big, fabs(floored[k]));
+    }
+    printf("Eq. 10 floor, walls slipping: %d rows away from the walls, |diff| <= %.3g of %.3g; "
+           "row i %.6g\n", far, worst, big, f->div[i]);
+    CHECK(far > 30 && worst <= 1e-12 * big);
+
+    /* the Laplacian's stencil in the assembly: mps_ops_divergence at re_lap */
+    CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
+    struct mps_ops_in in_l = {&f->nl, x, p->re_lap * p->dp, NULL, f->unknown, NULL};
+    mps_ops_divergence(&in_l, f->n0_lap, vs, rf, floored);
+    mps_ops_divergence(&in_l, f->n0_lap, vs, 0.0, plain);
+    worst = big = 0.0;
+    for (size_t k = 0; k < n; k++)
+        if (f->row[k] >= 0) {
+            worst = fmax(worst, fabs(f->div[k] - floored[k]));
+            big = fmax(big, fabs(floored[k]));
+        }
+    printf("Eq. 10 floor on the Laplacian's stencil: |assembly - mps_ops| <= %.3g of %.3g; row i "
+           "%.6g (%.6g as printed)\n", worst, big, f->div[i], plain[i]);
+    CHECK(f->row[i] >= 0 && f->row[j] >= 0 && worst <= 1e-12 * big);
+    CHECK(fabs(plain[i] - floored[i]) > 0.1 * fabs(plain[i]));
+    free(floored);
+    free(plain);
+    fluid_destroy(&f);
+}
+
 /* fluid.divergence_walls = slip: still water in the 10 mm tank moved as a
  * whole along the floor, v* = (0.5, 0) m/s for the fluid, the tank at rest.
  * The fluid is moved 0.3 dp along the floor off the wall's lattice. With the
@@ -1390,7 +1504,8 @@ static void test_divergence_slip(void)
                                                : 0.0;
         struct mps_ops_in in = {&f->nl_n, (const double(*)[MPS_DIM])f->x, p->re_n * p->dp,
                                 NULL, f->is_fluid, NULL};
-        mps_ops_divergence(&in, f->n0, (const double(*)[MPS_DIM])f->vstar, fixed);
+        mps_ops_divergence(&in, f->n0, (const double(*)[MPS_DIM])f->vstar,
+                           p->divergence_floor * p->dp, fixed);
         fluid_divergence_slip_walls(f, f->is_fluid);
         double big_fixed = 0.0, big_slip = 0.0, worst_normal = 0.0;
         int near_floor = 0;
@@ -1526,6 +1641,7 @@ int main(int argc, char **argv)
     test_collision();
     test_divergence_stencil();
     test_divergence_slip();
+    test_divergence_floor();
     test_verlet_list();
     test_surface_double_check();
     test_surface_thresholds_in_flow();

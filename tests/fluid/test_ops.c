@@ -16,7 +16,10 @@
  *     each component, on the AVX-512 path and the portable one;
  *   - the quadratic density (fluid.density_weight) is its lattice n0 on the
  *     regular lattice, and disorder raises it less than half as much as
- *     Eq. 8's number density (the reason it exists). */
+ *     Eq. 8's number density (the reason it exists);
+ *   - Eq. 10's floor (fluid.divergence_floor): a pair closer than it reads
+ *     as at it, d/n0 w(r_f) / r_f times the approach speed, whatever its
+ *     distance; a pair beyond it is Eq. 10 as printed. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -158,7 +161,7 @@ static void test_regular(void)
 
     /* Eq. 10: exact for a linear vector field in the interior */
     double e_div = 0.0;
-    mps_ops_divergence(&in, cn.n0, (const double(*)[MPS_DIM])v, div);
+    mps_ops_divergence(&in, cn.n0, (const double(*)[MPS_DIM])v, 0.0, div);
     for (int k = 0; k < N; k++)
         if (interior(k, 3))
             e_div = fmax(e_div, fabs(div[k] - 7.0));
@@ -335,6 +338,48 @@ static void test_laplacian_vec(void)
  * AVX-512 path with the portable one, and reports SKIPPED (77) where there is
  * no AVX-512 path (the CPU lacks it, or MPS_SIMD=sse2): without it those
  * parts test the portable path only, which the plain run covers. */
+/* One pair of the regular lattice closed to r, the second particle moving
+ * at u towards the first, every other velocity 0: the first's Eq. 10 is that
+ * pair's term alone, d/n0 w(r)/r^2 (-u r), or with the floor r_f > r,
+ * d/n0 w(r_f)/(r_f r) (-u r) = -d/n0 u w(r_f)/r_f. */
+static void test_divergence_floor(void)
+{
+    static struct lattice L;
+    const double u = 1.5, rf = 0.5 * DP, re = 2.1 * DP;
+    const int a = (NY / 2) * NX + NX / 2, b = a + 1; /* neighbours along x */
+    const double r_over_dp[] = {0.2, 0.3, 0.45, 0.6, 0.9};
+    static double v[N][MPS_DIM], div[N];
+    struct mps_lattice_consts cn = mps_lattice_consts(DP, re);
+    for (size_t t = 0; t < sizeof r_over_dp / sizeof r_over_dp[0]; t++) {
+        const double r = r_over_dp[t] * DP;
+        build(&L, 0.0, 1);
+        L.x[b][0] = L.x[a][0] + r;
+        release(&L); /* the lists again, with the pair closed */
+        struct mps_err err = {0};
+        CHECK(mps_nbr_grid_build(&L.g, N, (const double(*)[MPS_DIM])L.x, 4.0 * DP, &err) ==
+              MPS_OK);
+        CHECK(mps_nbr_list_build(&L.ln, &L.g, (const double(*)[MPS_DIM])L.x, N, re, &err) ==
+              MPS_OK);
+        CHECK(mps_nbr_list_build(&L.ll, &L.g, (const double(*)[MPS_DIM])L.x, N, 4.0 * DP, &err) ==
+              MPS_OK);
+        memset(v, 0, sizeof v);
+        v[b][0] = -u;
+        struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, re, NULL, NULL, NULL};
+        mps_ops_divergence(&in, cn.n0, (const double(*)[MPS_DIM])v, rf, div);
+        const double floored = div[a];
+        mps_ops_divergence(&in, cn.n0, (const double(*)[MPS_DIM])v, 0.0, div);
+        const double plain = div[a];
+        const double want_plain = -MPS_DIM / cn.n0 * u * (re / r - 1.0) / r;
+        const double want = r < rf ? -MPS_DIM / cn.n0 * u * (re / rf - 1.0) / rf : want_plain;
+        printf("Eq. 10, a pair at %.2f dp closing at %.1f m/s: %.6g 1/s with the floor at 0.5 dp "
+               "(want %.6g), %.6g without (want %.6g)\n",
+               r_over_dp[t], u, floored, want, plain, want_plain);
+        CHECK_NEAR(floored, want, 1e-12 * fabs(want));
+        CHECK_NEAR(plain, want_plain, 1e-12 * fabs(want_plain));
+        release(&L);
+    }
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -350,5 +395,6 @@ int main(int argc, char **argv)
     test_perturbed(0.2);
     test_density_disorder();
     test_laplacian_vec();
+    test_divergence_floor();
     return test_summary("test_fluid_ops");
 }
