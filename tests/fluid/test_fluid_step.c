@@ -1237,6 +1237,17 @@ static void test_side_walls(void)
     side_walls_case(0);
 }
 
+/* The Eq. 10 tests' v*: a divergence, a rotation and a disordered part for
+ * the first `upto` particles, 0 for the rest. */
+static void smooth_vstar(struct fluid *f, size_t upto)
+{
+    for (size_t k = 0; k < f->ps.n; k++) {
+        double x = f->x[k][0], y = f->x[k][1], on = k < upto;
+        f->vstar[k][0] = on ? 0.7 * x + 0.3 * y + 0.01 * sin(1e3 * x * y + (double)k) : 0.0;
+        f->vstar[k][1] = on ? -0.2 * x + 0.4 * y + 0.01 * cos(7e2 * x + (double)k) : 0.0;
+    }
+}
+
 /* fluid.divergence_stencil = laplacian: the assembly's Eq. 10 on the
  * Laplacian's neighbours (from the weights pass 1 packed) against Eq. 10
  * written by mps_ops_divergence over the same list at re_lap with n0 at
@@ -1252,11 +1263,7 @@ static void test_divergence_stencil(void)
         return;
     const double dt = 1e-3;
     const size_t n = f->ps.n;
-    for (size_t i = 0; i < n; i++) {
-        double x = f->x[i][0], y = f->x[i][1];
-        f->vstar[i][0] = 0.7 * x + 0.3 * y + 0.01 * sin(1e3 * x * y + (double)i);
-        f->vstar[i][1] = -0.2 * x + 0.4 * y + 0.01 * cos(7e2 * x + (double)i);
-    }
+    smooth_vstar(f, n);
     struct mps_err err = {0};
     CHECK(fluid_ppe_assemble(f, dt, &err) == MPS_OK);
     double *want = calloc(n, sizeof *want);
@@ -1310,11 +1317,7 @@ static void test_divergence_near_bodies(void)
     struct mps_err err = {0};
     CHECK(f->prm.divergence_near_bodies && !f->prm.divergence_wide);
     const size_t n = f->ps.n;
-    for (size_t i = 0; i < n; i++) {
-        double x = f->x[i][0], y = f->x[i][1];
-        f->vstar[i][0] = 0.7 * x + 0.3 * y + 0.01 * sin(1e3 * x * y + (double)i);
-        f->vstar[i][1] = -0.2 * x + 0.4 * y + 0.01 * cos(7e2 * x + (double)i);
-    }
+    smooth_vstar(f, n);
     double *narrow = calloc(n, sizeof *narrow), *wide = calloc(n, sizeof *wide);
     CHECK(narrow && wide);
     if (!narrow || !wide) {
@@ -1401,11 +1404,7 @@ static void test_divergence_floor(void)
     struct mps_err err = {0};
     CHECK(mps_nbr_list_filter(&f->nl_n, &f->nl, (const double(*)[MPS_DIM])f->x, re, &err) ==
           MPS_OK);
-    for (size_t k = 0; k < n; k++) {
-        double x = f->x[k][0], y = f->x[k][1];
-        f->vstar[k][0] = k < f->nfluid ? 0.7 * x + 0.3 * y + 0.01 * sin(1e3 * x * y + (double)k) : 0.0;
-        f->vstar[k][1] = k < f->nfluid ? -0.2 * x + 0.4 * y + 0.01 * cos(7e2 * x + (double)k) : 0.0;
-    }
+    smooth_vstar(f, f->nfluid);
     for (int d = 0; d < MPS_DIM; d++)
         f->vstar[j][d] -= 1.0 * e[d];
     double *floored = calloc(n, sizeof *floored), *plain = calloc(n, sizeof *plain);
