@@ -58,6 +58,7 @@ static void register_fields(struct fluid *f)
     mps_particles_add_field(ps, "grad_fallback", 1, MPS_U8, (void **)&f->fallback, "", 0);
     mps_particles_add_field(ps, "body_normal", MPS_DIM, MPS_F64, (void **)&f->body_n, "", 0);
     mps_particles_add_field(ps, "in_body", 1, MPS_U8, (void **)&f->in_body, "", 0);
+    mps_particles_add_field(ps, "ppe_held", 1, MPS_U8, (void **)&f->ppe_held, "", 0);
 }
 
 void fluid_update_masks(struct fluid *f)
@@ -248,6 +249,7 @@ void fluid_destroy(struct fluid **pf)
     free(f->row_held_next);
     free(f->row_list);
     free(f->row_touched);
+    free(f->row_seed);
     fluid_linsolve_destroy(&f->ls);
     fluid_sensors_destroy(&f->sens);
     free(f);

@@ -134,7 +134,8 @@ struct fluid {
      * fluid, held at P = 0 now, next (fluid_ppe.c) */
     double *val_assembled, *rhs_assembled;
     unsigned char *row_is_fluid, *row_held, *row_held_next;
-    unsigned char *row_touched; /* scratch, one byte a row */
+    unsigned char *row_touched, *row_seed; /* scratch, one byte a row */
+    unsigned char *ppe_held;    /* per particle: its row was held at P = 0 in the last solve */
     int *row_list;  /* the rows fluid.tension_sweeps sweeps; then those a re-solve changes */
     size_t cap_held_rows, cap_held_nnz;
     int keep_ppe_terms;

@@ -139,6 +139,13 @@ const struct mps_key_spec fluid_case_keys[] = {
      "the first solve's negative ones, from its clamped pressure; the rows they leave at "
      "P = 0 are the first held set. The same answer, in fewer solves; 0: hold the first "
      "solve's negative rows (docs/pressure.md, \"Where the held rows start\")"},
+    {"fluid.tension_start", MPS_KEY_ENUM, "last_step", 0, 0, 0, "last_step|first_solve", "",
+     "where the rows under tension start (with fluid.tension_solves): the rows whose "
+     "particles the last step held at P = 0, swept (fluid.tension_sweeps) from the last "
+     "step's pressure, and solved with them held from the first solve (last_step); or a "
+     "first solve with none held, whose negative rows start the sweeps (first_solve, the "
+     "default before 2026-12-07). A step whose particles the last held none of starts as "
+     "first_solve does. The same answer, in fewer solves (docs/fluid_speed.md)"},
     {"fluid.collision_distance", MPS_KEY_DOUBLE, "0.9", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
      "fluid particles closer than this are pushed apart (0: off)"},
     {"fluid.collision_restitution", MPS_KEY_DOUBLE, "0.2", 0, 1, 0, NULL, "",
@@ -392,6 +399,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
                            "them to 0/true",
                            mps_case_origin(c), p->tension_solves);
     p->tension_sweeps = (int)mps_case_int(c, "fluid.tension_sweeps");
+    p->tension_start_last = strcmp(mps_case_string(c, "fluid.tension_start"), "last_step") == 0;
     p->collision_dist = mps_case_double(c, "fluid.collision_distance");
     p->collision_restitution = mps_case_double(c, "fluid.collision_restitution");
     p->side_wall_breadth = mps_case_double(c, "fluid.side_walls.breadth");

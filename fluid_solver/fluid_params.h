@@ -86,6 +86,7 @@ struct fluid_params {
     int clamp_negative;           /* negative PPE pressures set to 0 */
     int tension_solves;           /* more PPE solves releasing rows under tension (0: clamp) */
     int tension_sweeps;           /* projected Gauss-Seidel sweeps for the first held set */
+    int tension_start_last;       /* the held set starts from the last step's (fluid.tension_start) */
     double collision_dist;        /* fraction of dp; 0 = off */
     double collision_restitution;
     double side_wall_breadth;     /* m: 0 = no side walls (2D) */

@@ -536,6 +536,7 @@ static int grow_held_rows(struct fluid *f, size_t need)
     f->rhs_assembled = mps_realloc_or_flag(f->rhs_assembled, c, sizeof(double), &fail);
     f->row_list = mps_realloc_or_flag(f->row_list, c, sizeof(int), &fail);
     f->row_touched = mps_realloc_or_flag(f->row_touched, c, 1, &fail);
+    f->row_seed = mps_realloc_or_flag(f->row_seed, c, 1, &fail);
     f->row_is_fluid = mps_realloc_or_flag(f->row_is_fluid, c, 1, &fail);
     f->row_held = mps_realloc_or_flag(f->row_held, c, 1, &fail);
     f->row_held_next = mps_realloc_or_flag(f->row_held_next, c, 1, &fail);
@@ -554,17 +555,22 @@ static int grow_held_rows(struct fluid *f, size_t need)
  * they left within 2-3 rows the set the solves settle on (bench/tension_sets.py).
  * Only the rows within three neighbour rings of a negative one are swept:
  * elsewhere the first solve's pressure stands. Serial, in row order, so
- * the start is the same for any thread count. In: held = the first solve's
- * negative fluid rows; out: the swept rows at P = 0, and f->sol the swept
- * pressure (the re-solve's warm start). mark: scratch, one byte a row. */
-static int held_start_sweeps(struct fluid *f, const unsigned char *is_fluid, unsigned char *held,
-                             unsigned char *mark)
+ * the start is the same for any thread count. seed: the rows swept around,
+ * the first solve's negative fluid rows with f->sol its pressure, or
+ * (fluid.tension_start = last_step) the rows the last step held with
+ * f->sol the last step's pressure, then the first solve's rows newly
+ * negative; held: out, the swept rows' entries set (P = 0 or not), the
+ * others kept (seed may be held); f->sol the swept pressure (the next
+ * solve's warm start). mark: scratch, one byte a row. Returns the rows
+ * held. */
+static int held_start_sweeps(struct fluid *f, const unsigned char *is_fluid, const unsigned char *seed,
+                             unsigned char *held, unsigned char *mark)
 {
     const int nr = f->nrows;
     int *local = f->row_list, nlocal = 0;
     memset(mark, 0, (size_t)nr);
     for (int r = 0; r < nr; r++)
-        if (held[r]) {
+        if (seed[r]) {
             mark[r] = 1;
             local[nlocal++] = r;
         }
@@ -604,12 +610,13 @@ static int held_start_sweeps(struct fluid *f, const unsigned char *is_fluid, uns
             const double v = (f->rhs[r] - off) / diag;
             P[r] = (is_fluid[r] && v < 0.0) ? 0.0 : v;
         }
-    int nheld = 0;
     for (int k = 0; k < nlocal; k++) {
         const int r = local[k];
         held[r] = is_fluid[r] && P[r] <= 0.0;
-        nheld += held[r];
     }
+    int nheld = 0;
+    for (int r = 0; r < nr; r++)
+        nheld += held[r];
     return nheld;
 }
 
@@ -647,9 +654,13 @@ static int rows_touched(struct fluid *f, const unsigned char *now, const unsigne
  * that came out negative, let go the held ones whose equation asks for a
  * pressure, solve again) settles in a few solves, to the one solution
  * whatever the set it starts from. The held rows are decoupled, not
- * removed, so the matrix keeps its pattern and rows. */
+ * removed, so the matrix keeps its pattern and rows. warm: the set starts
+ * from the rows the last step held (fluid.tension_start = last_step), and
+ * the first solve is the first with rows held: the tension moves little in
+ * a step, so the solve without any held that would find it again is spared
+ * (0.8 mm dam break: 3.5 solves a step -> 2.1, docs/fluid_speed.md). */
 static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_stats *stats,
-                                       struct mps_err *err)
+                                       int warm, struct mps_err *err)
 {
     const int nr = f->nrows;
     const size_t nnz = (size_t)f->rowptr[nr];
@@ -663,21 +674,31 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
         if (f->row[i] >= 0)
             is_fluid[f->row[i]] = f->is_fluid[i];
     int nheld = 0;
-    for (int r = 0; r < nr; r++) {
-        held[r] = is_fluid[r] && f->sol[r] < 0.0;
-        nheld += held[r];
+    if (warm) {
+        for (size_t i = 0; i < f->ps.n; i++)
+            if (f->row[i] >= 0)
+                held[f->row[i]] = is_fluid[f->row[i]] && f->ppe_held[i];
+        for (int r = 0; r < nr; r++)
+            nheld += held[r];
+    } else {
+        for (int r = 0; r < nr; r++) {
+            held[r] = is_fluid[r] && f->sol[r] < 0.0;
+            nheld += held[r];
+        }
     }
     if (nheld == 0)
         return MPS_OK;
+    /* warm: the sweeps may let go every row; the loop's first solve is then
+     * the plain one */
     if (f->prm.tension_sweeps > 0)
-        nheld = held_start_sweeps(f, is_fluid, held, next);
+        nheld = held_start_sweeps(f, is_fluid, held, held, next);
     memcpy(val0, f->val, nnz * sizeof(double));
     memcpy(rhs0, f->rhs, (size_t)nr * sizeof(double));
     struct fluid_csr A = {nr, f->rowptr, f->col, f->val};
     enum mps_status st = MPS_OK;
     int solves = 0, changed = 1;
     int nlist = rows_touched(f, held, NULL);
-    while (changed && solves < f->prm.tension_solves) {
+    while (changed && solves < f->prm.tension_solves + warm) {
         /* a held row keeps its diagonal and rhs 0, so its solution is 0;
          * only the rows the last change of the set touched are rewritten */
         const int *list = f->row_list;
@@ -693,14 +714,17 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
                 f->sol[r] = 0.0;
         }
         struct fluid_linsolve_stats ls;
-        fluid_linsolve_changed_rows(f->ls, list, nlist); /* held rows keep their zeros */
-        st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, &ls, err);
+        const int first = warm && solves == 0; /* a new matrix: set up in full */
+        if (!first)
+            fluid_linsolve_changed_rows(f->ls, list, nlist); /* held rows keep their zeros */
+        st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, first ? stats : &ls, err);
         if (st) {
             mps_err_prefix(err, "PPE at t = %.6g s, solve %d with %d rows under tension held "
-                                "at P = 0: ", f->time, solves + 2, nheld);
+                                "at P = 0: ", f->time, solves + 2 - warm, nheld);
             break;
         }
-        stats->iterations += ls.iterations;
+        if (!first)
+            stats->iterations += ls.iterations;
         solves++;
         /* exactly 0: pcg_defl's coarse correction leaves a round-off there */
 #pragma omp parallel for schedule(static)
@@ -722,6 +746,24 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
             changed |= next[r] != held[r];
             nheld += next[r];
         }
+        if (changed && first && f->prm.tension_sweeps > 0) {
+            /* rows newly under tension, the last step's held rows not near
+             * them (an impact, a new sheet): swept as a first solve's
+             * negative rows are, the rest of the set kept (0.8 mm dam
+             * break: 1.1 more solves a step against 1.3 without) */
+            unsigned char *seed = f->row_seed;
+            int nseed = 0;
+            for (int r = 0; r < nr; r++) {
+                seed[r] = !held[r] && is_fluid[r] && f->sol[r] < 0.0;
+                nseed += seed[r];
+            }
+            if (nseed > 0) {
+                nheld = held_start_sweeps(f, is_fluid, seed, next, f->row_touched);
+                changed = 0;
+                for (int r = 0; r < nr; r++)
+                    changed |= next[r] != held[r];
+            }
+        }
         if (changed)
             nlist = rows_touched(f, next, held);
         unsigned char *t = held;
@@ -730,7 +772,7 @@ static enum mps_status release_tension(struct fluid *f, struct fluid_linsolve_st
     }
     f->row_held = held;
     f->row_held_next = next;
-    f->last.tension_solves = solves;
+    f->last.tension_solves = solves - warm;
     /* the system as assembled, as --dump-ppe writes it */
     memcpy(f->val, val0, nnz * sizeof(double));
     memcpy(f->rhs, rhs0, (size_t)nr * sizeof(double));
@@ -751,13 +793,26 @@ enum mps_status fluid_ppe_solve(struct fluid *f, struct fluid_linsolve_stats *st
             return st;
     }
     if (f->nrows > 0) {
-        st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, stats, err);
-        if (st)
-            return mps_err_prefix(err, "PPE at t = %.6g s (%d unknowns): ", f->time, f->nrows);
-        if (f->prm.tension_solves > 0 && (st = release_tension(f, stats, err)))
-            return st;
+        int warm = 0;
+        if (f->prm.tension_solves > 0 && f->prm.tension_start_last)
+            for (size_t i = 0; i < f->ps.n && !warm; i++)
+                warm = f->row[i] >= 0 && f->is_fluid[i] && f->ppe_held[i];
+        if (warm) {
+            if ((st = release_tension(f, stats, 1, err)))
+                return st;
+        } else {
+            st = fluid_linsolve_solve(f->ls, &A, f->rhs, f->sol, stats, err);
+            if (st)
+                return mps_err_prefix(err, "PPE at t = %.6g s (%d unknowns): ", f->time, f->nrows);
+            if (f->prm.tension_solves > 0 && (st = release_tension(f, stats, 0, err)))
+                return st;
+        }
+        const unsigned char *held = f->row_held;
+        for (size_t i = 0; i < f->ps.n; i++)
+            f->ppe_held[i] = f->prm.tension_solves > 0 && f->row[i] >= 0 && held[f->row[i]];
     } else {
         *stats = (struct fluid_linsolve_stats){0};
+        memset(f->ppe_held, 0, f->ps.n);
     }
     const int clamp = f->prm.clamp_negative;
 #pragma omp parallel for schedule(static)

@@ -1620,6 +1620,65 @@ static void test_shifting(void)
     }
 }
 
+/* Where the rows under tension start (fluid.tension_start): from the rows
+ * the last step held, the step must reach the complementarity problem's
+ * one solution, as a start from a first solve does, in fewer solves; and a
+ * rollback must restore the held rows with the particles, so that the
+ * repeated step (implicit coupling, restart) is the same to the bit. */
+static void test_tension_start(void)
+{
+    const char *sets[] = {"dp=0.008"};
+    struct fluid *f = make_stepped("cases/dambreak/case.yml", sets, 1, 100);
+    if (!f)
+        return;
+    CHECK(f->prm.tension_start_last == 1);
+    struct mps_err err = {0};
+    struct fluid_ckpt ck = {0};
+    const size_t n = f->nfluid;
+    int held = 0;
+    for (size_t i = 0; i < n; i++)
+        held += f->ppe_held[i];
+    printf("tension start: %d particles held at 100 ms\n", held);
+    CHECK(held > 10);
+    CHECK(fluid_ckpt_save(f, &ck, &err) == MPS_OK);
+    double *p_last = malloc(n * sizeof *p_last);
+    CHECK(step(f, 1e-3) == MPS_OK);
+    memcpy(p_last, f->p, n * sizeof *p_last);
+    /* the repeated step, from the restored held rows */
+    CHECK(fluid_ckpt_restore(f, &ck, &err) == MPS_OK);
+    CHECK(step(f, 1e-3) == MPS_OK);
+    CHECK(memcmp(p_last, f->p, n * sizeof *p_last) == 0);
+    /* the same step from a first solve: within the PCG's tolerance (as
+     * tests/fluid/test_ppe_terms.py bounds the complementarity solution,
+     * 0.1% of rho g H, H = 0.292 m the column) */
+    CHECK(fluid_ckpt_restore(f, &ck, &err) == MPS_OK);
+    f->prm.tension_start_last = 0;
+    CHECK(step(f, 1e-3) == MPS_OK);
+    double worst = 0.0;
+    for (size_t i = 0; i < n; i++)
+        worst = fmax(worst, fabs(f->p[i] - p_last[i]));
+    const double band = 1e-3 * f->prm.rho * 9.81 * 0.292;
+    printf("tension start: last step's held rows against a first solve: %.3g Pa apart "
+           "(band %.3g)\n", worst, band);
+    CHECK(worst <= band);
+    /* fewer solves over the next 20 steps */
+    int solves[2] = {0, 0};
+    for (int mode = 0; mode < 2; mode++) {
+        CHECK(fluid_ckpt_restore(f, &ck, &err) == MPS_OK);
+        f->prm.tension_start_last = mode;
+        for (int k = 0; k < 20; k++) {
+            CHECK(step(f, 1e-3) == MPS_OK);
+            solves[mode] += f->last.tension_solves;
+        }
+    }
+    printf("tension start: more solves over 20 steps: %d from a first solve, %d from the "
+           "last step's held rows\n", solves[0], solves[1]);
+    CHECK(solves[1] < solves[0]);
+    free(p_last);
+    fluid_ckpt_free(&ck);
+    fluid_destroy(&f);
+}
+
 int main(int argc, char **argv)
 {
     if (argc > 1 && strcmp(argv[1], "avx512") == 0) {
@@ -1652,5 +1711,6 @@ int main(int argc, char **argv)
     test_side_walls();
     test_jitter();
     test_shifting();
+    test_tension_start();
     return test_summary("test_fluid_step");
 }

@@ -135,6 +135,33 @@ FAULTS = [
       new='    for (int ring = 0, from = 0; ring < 0; ring++) {',
       what='the sweeps cover only the rows the first solve left negative, not the rings around them whose pressure was computed against those',
       hint='fluid_ppe_terms'),
+    F(id='tension_start_unswept', eq='no tension: the held rows\' start (fluid.tension_start)', file='fluid_solver/fluid_ppe.c',
+      old='''    if (f->prm.tension_sweeps > 0)
+        nheld = held_start_sweeps(f, is_fluid, held, held, next);''',
+      new='''    if (!warm && f->prm.tension_sweeps > 0)
+        nheld = held_start_sweeps(f, is_fluid, held, held, next);''',
+      what='the rows the last step held start the set as they are, without the sweeps around them against this step\'s system',
+      hint='fluid_ppe_terms'),
+    F(id='tension_start_not_kept', eq='no tension: the held rows\' start (fluid.tension_start)', file='fluid_solver/fluid_ppe.c',
+      old='            f->ppe_held[i] = f->prm.tension_solves > 0 && f->row[i] >= 0 && held[f->row[i]];',
+      new='            f->ppe_held[i] = f->prm.tension_solves < 0 && f->row[i] >= 0 && held[f->row[i]];',
+      what='the held rows are not kept with the particles: every step starts from a first solve again (the default\'s saving lost)',
+      hint='fluid_ppe_terms|test_fluid_step'),
+    F(id='tension_start_no_resweep', eq='no tension: the held rows\' start (fluid.tension_start)', file='fluid_solver/fluid_ppe.c',
+      old='        if (changed && first && f->prm.tension_sweeps > 0) {',
+      new='        if (changed && first && f->prm.tension_sweeps < 0) {',
+      what='the rows the first solve leaves newly under tension, away from the last step\'s held rows, are not swept: the set grows towards them one ring a re-solve',
+      hint='fluid_ppe_terms'),
+    F(id='tension_start_rollback', eq='no tension: the held rows\' start, rolled back (implicit coupling)', file='fluid_solver/fluid_checkpoint.c',
+      old='''    enum mps_status st = mps_particles_get(&f->ps, &c->img, err);
+    if (!st)
+        st = get_rest(f, &c->img, err);''',
+      new='''    enum mps_status st = mps_particles_get(&f->ps, &c->img, err);
+    memset(f->ppe_held, 0, f->ps.n);
+    if (!st)
+        st = get_rest(f, &c->img, err);''',
+      what='a rollback forgets the rows the last step held: the repeated step starts from a first solve, not the same to the bit',
+      hint='test_fluid_step'),
     F(id='defl_refill_stale', eq='pcg_defl set-up on the same pattern', file='fluid_solver/fluid_defl.c',
       old='        s->ztval[s->azpos[base + q]] = v[q];',
       new='        s->ztval[s->azpos[base + q]] += 0.0 * v[q];',
