@@ -351,10 +351,11 @@ static enum mps_status restart_or_setup(struct run *r, const struct mps_cli *cli
     mps_ckpt_path(r->restart_path, sizeof r->restart_path, cli->restart_dir, "fluid",
                   r->mark.number);
     r->restart_time = r->disk.time;
-    if ((st = setup(r, case_path, cli->sets, cli->nsets, "fluid", err)) ||
-        (st = mps_run_get_rest(&r->disk, r->h5, err)) ||
-        (st = fluid_state_get(r->f, &r->disk, err)))
+    if ((st = setup(r, case_path, cli->sets, cli->nsets, "fluid", err)))
         return st;
+    /* a block out of place: a checkpoint of another build (a field added) */
+    if ((st = mps_run_get_rest(&r->disk, r->h5, err)) || (st = fluid_state_get(r->f, &r->disk, err)))
+        return mps_err_prefix(err, "%s: ", r->restart_path);
     if (!cli->quiet)
         fprintf(stderr, "fluid_solver: restarting %s at t = %.9g s (step %ld)\n", cli->restart_dir,
                 r->f->time, r->f->step);
@@ -398,10 +399,11 @@ static enum mps_status peer_resume(void *self, long number, struct mps_err *err)
 {
     struct run *r = self;
     enum mps_status st;
+    mps_ckpt_path(r->restart_path, sizeof r->restart_path, r->out, r->prefix, number);
+    /* a block out of place: a checkpoint of another build (a field added) */
     if ((st = mps_run_get_rest(&r->disk, r->h5, err)) ||
         (st = fluid_state_get(r->f, &r->disk, err)))
-        return st;
-    mps_ckpt_path(r->restart_path, sizeof r->restart_path, r->out, r->prefix, number);
+        return mps_err_prefix(err, "%s: ", r->restart_path);
     r->restart_time = r->f->time;
     return MPS_OK;
 }

@@ -234,9 +234,12 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     free(names);
     if (st != MPS_OK)
         goto done;
+    /* a block out of place: a checkpoint of another build (a field added) */
     if (cli->restart_dir && ((st = mps_run_get_rest(&r.disk, r.h5, err)) != MPS_OK ||
-                             (st = r.ops->state_get(r.model, &r.disk, err)) != MPS_OK))
+                             (st = r.ops->state_get(r.model, &r.disk, err)) != MPS_OK)) {
+        mps_err_prefix(err, "%s: ", r.restart_path);
         goto done;
+    }
     if (!r.ops->state_put && ck_dt > 0.0) {
         st = mps_err_set(err, MPS_EINPUT, "output.checkpoint_interval = %g: the solid model %s "
                          "cannot checkpoint (set it to 0)", ck_dt, r.ops->name);

@@ -134,13 +134,15 @@ static enum mps_status resume(void *self, long number, struct mps_err *err)
     enum mps_status st;
     if (!p->ops->state_get)
         return mps_err_set(err, MPS_EINPUT, "solid model %s cannot restart", p->ops->name);
-    if ((st = mps_run_read(&p->disk, p->out, p->prefix, number, &p->mark, err)) ||
-        (st = mps_run_get_rest(&p->disk, p->h5, err)) ||
-        (st = p->ops->state_get(p->model, &p->disk, err)))
+    if ((st = mps_run_read(&p->disk, p->out, p->prefix, number, &p->mark, err)))
         return st;
+    mps_ckpt_path(p->restart_path, sizeof p->restart_path, p->out, p->prefix, number);
+    /* a block out of place: a checkpoint of another build (a field added) */
+    if ((st = mps_run_get_rest(&p->disk, p->h5, err)) ||
+        (st = p->ops->state_get(p->model, &p->disk, err)))
+        return mps_err_prefix(err, "%s: ", p->restart_path);
     p->substeps = p->mark.steps;
     p->restart_time = p->disk.time;
-    mps_ckpt_path(p->restart_path, sizeof p->restart_path, p->out, p->prefix, number);
     return MPS_OK;
 }
 

@@ -147,6 +147,20 @@ set_tests_properties(restart_bad_implicit_no_loads PROPERTIES TIMEOUT 60 LABELS 
 
 mps_add_test(test_ckpt SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ckpt.c LABELS unit TIMEOUT 30)
 
+# A solver checkpoint of a build with one particle field fewer (the fluid's
+# held rows, ppe_held, 2026-12-07): refused, naming the file and the block,
+# coupled (the fluid's CONFIG restart) and alone (--restart)
+add_test(NAME restart_bad_fluid_checkpoint_older_build
+  COMMAND sh -c "rm -rf \"$1\" && \"$0\" tests/coupler/plate_in_water.yml --out \"$1\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$1\"/checkpoint/fluid_000001.ckpt ppe_held --only && { \"$0\" --restart \"$1\" 2>\"$1.err\"; rc=$?; test $rc -eq 2 && grep -q \"^coupler: input: fluid solver: input: .*fluid_000001.ckpt: checkpoint: block '.*' where 'ppe_held' should be\" \"$1.err\"; }"
+          $<TARGET_FILE:coupler> ${RS_OUT}/fluid_older
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_bad_fluid_checkpoint_older_build PROPERTIES TIMEOUT 60 LABELS integration)
+add_test(NAME restart_bad_fluid_alone_checkpoint_older_build
+  COMMAND sh -c "rm -rf \"$1\" && \"$0\" cases/dambreak/case.yml --out \"$1\" --quiet --set dp=0.02 --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$1\"/checkpoint/fluid_000001.ckpt ppe_held --only && { \"$0\" --restart \"$1\" 2>\"$1.err\"; rc=$?; test $rc -eq 2 && grep -q \"^fluid_solver: input: .*fluid_000001.ckpt: checkpoint: block '.*' where 'ppe_held' should be\" \"$1.err\"; }"
+          $<TARGET_FILE:fluid_solver> ${RS_OUT}/fluid_alone_older
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_bad_fluid_alone_checkpoint_older_build PROPERTIES TIMEOUT 60 LABELS integration)
+
 # Bad restarts: one clear line, exit 2 (tests/expect_fail.sh)
 set(RS_FAIL sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh)
 function(restart_bad name pattern)
