@@ -149,17 +149,20 @@ mps_add_test(test_ckpt SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ckpt.c LABELS unit
 
 # A solver checkpoint of a build with one particle field fewer (the fluid's
 # held rows, ppe_held, 2026-12-07): refused, naming the file and the block,
-# coupled (the fluid's CONFIG restart) and alone (--restart)
-add_test(NAME restart_bad_fluid_checkpoint_older_build
-  COMMAND sh -c "rm -rf \"$1\" && \"$0\" tests/coupler/plate_in_water.yml --out \"$1\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$1\"/checkpoint/fluid_000001.ckpt ppe_held --only && { \"$0\" --restart \"$1\" 2>\"$1.err\"; rc=$?; test $rc -eq 2 && grep -q \"^coupler: input: fluid solver: input: .*fluid_000001.ckpt: checkpoint: block '.*' where 'ppe_held' should be\" \"$1.err\"; }"
-          $<TARGET_FILE:coupler> ${RS_OUT}/fluid_older
-  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(restart_bad_fluid_checkpoint_older_build PROPERTIES TIMEOUT 60 LABELS integration)
-add_test(NAME restart_bad_fluid_alone_checkpoint_older_build
-  COMMAND sh -c "rm -rf \"$1\" && \"$0\" cases/dambreak/case.yml --out \"$1\" --quiet --set dp=0.02 --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$1\"/checkpoint/fluid_000001.ckpt ppe_held --only && { \"$0\" --restart \"$1\" 2>\"$1.err\"; rc=$?; test $rc -eq 2 && grep -q \"^fluid_solver: input: .*fluid_000001.ckpt: checkpoint: block '.*' where 'ppe_held' should be\" \"$1.err\"; }"
-          $<TARGET_FILE:fluid_solver> ${RS_OUT}/fluid_alone_older
-  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
-set_tests_properties(restart_bad_fluid_alone_checkpoint_older_build PROPERTIES TIMEOUT 60 LABELS integration)
+# coupled (the fluid's CONFIG restart) and alone (--restart). who: the line's
+# start, the program that prints it
+function(restart_older_build name program who)
+  add_test(NAME restart_bad_${name}_checkpoint_older_build
+    COMMAND sh -c "o=\"$1\"; shift; rm -rf \"$o\" && \"$0\" \"$@\" --out \"$o\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$o\"/checkpoint/fluid_000001.ckpt ppe_held --only && { \"$0\" --restart \"$o\" 2>\"$o.err\"; rc=$?; test $rc -eq 2 && grep -q \"^${who}: input: .*fluid_000001.ckpt: checkpoint: block '.*' where 'ppe_held' should be\" \"$o.err\"; }"
+            ${program} ${RS_OUT}/${name}_older ${ARGN}
+    WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+  set_tests_properties(restart_bad_${name}_checkpoint_older_build PROPERTIES TIMEOUT 60
+    LABELS integration)
+endfunction()
+restart_older_build(fluid $<TARGET_FILE:coupler> "coupler: input: fluid solver"
+                    tests/coupler/plate_in_water.yml)
+restart_older_build(fluid_alone $<TARGET_FILE:fluid_solver> fluid_solver
+                    cases/dambreak/case.yml --set dp=0.02)
 
 # Bad restarts: one clear line, exit 2 (tests/expect_fail.sh)
 set(RS_FAIL sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh)
