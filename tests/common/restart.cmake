@@ -148,21 +148,27 @@ set_tests_properties(restart_bad_implicit_no_loads PROPERTIES TIMEOUT 60 LABELS 
 mps_add_test(test_ckpt SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ckpt.c LABELS unit TIMEOUT 30)
 
 # A solver checkpoint of a build with one particle field fewer (the fluid's
-# held rows, ppe_held, 2026-12-07): refused, naming the file and the block,
-# coupled (the fluid's CONFIG restart) and alone (--restart). who: the line's
-# start, the program that prints it
-function(restart_older_build name program who)
+# held rows, ppe_held, 2026-12-07; the solid's rotation rate, omega, stands
+# for any of its fields): refused, naming the file and the block, coupled
+# (the solver's CONFIG restart) and alone (--restart). who: the line's start,
+# the program that prints it; solver: fluid or solid, whose checkpoint is cut;
+# block: the block dropped, the next block named in its place
+function(restart_older_build name program who solver block)
   add_test(NAME restart_bad_${name}_checkpoint_older_build
-    COMMAND sh -c "o=\"$1\"; shift; rm -rf \"$o\" && \"$0\" \"$@\" --out \"$o\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$o\"/checkpoint/fluid_000001.ckpt ppe_held --only && { \"$0\" --restart \"$o\" 2>\"$o.err\"; rc=$?; test $rc -eq 2 && grep -q \"^${who}: input: .*fluid_000001.ckpt: checkpoint: block '.*' where 'ppe_held' should be\" \"$o.err\"; }"
+    COMMAND sh -c "o=\"$1\"; shift; rm -rf \"$o\" && \"$0\" \"$@\" --out \"$o\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && /usr/bin/python3 tests/common/ckpt_cut.py \"$o\"/checkpoint/${solver}_000001.ckpt ${block} --only && { \"$0\" --restart \"$o\" 2>\"$o.err\"; rc=$?; test $rc -eq 2 && grep -q \"^${who}: .*${solver}_000001.ckpt: checkpoint: block '.*' where '${block}' should be\" \"$o.err\"; }"
             ${program} ${RS_OUT}/${name}_older ${ARGN}
     WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
   set_tests_properties(restart_bad_${name}_checkpoint_older_build PROPERTIES TIMEOUT 60
     LABELS integration)
 endfunction()
-restart_older_build(fluid $<TARGET_FILE:coupler> "coupler: input: fluid solver"
-                    tests/coupler/plate_in_water.yml)
-restart_older_build(fluid_alone $<TARGET_FILE:fluid_solver> fluid_solver
-                    cases/dambreak/case.yml --set dp=0.02)
+restart_older_build(fluid $<TARGET_FILE:coupler> "coupler: input: fluid solver: input"
+                    fluid ppe_held tests/coupler/plate_in_water.yml)
+restart_older_build(fluid_alone $<TARGET_FILE:fluid_solver> "fluid_solver: input"
+                    fluid ppe_held cases/dambreak/case.yml --set dp=0.02)
+restart_older_build(solid $<TARGET_FILE:coupler> "coupler: input: solid solver: input"
+                    solid omega tests/coupler/plate_in_water.yml)
+restart_older_build(solid_alone $<TARGET_FILE:solid_solver> solid_solver
+                    solid omega cases/fracture_collision/case.yml --set dp=0.025)
 
 # Bad restarts: one clear line, exit 2 (tests/expect_fail.sh)
 set(RS_FAIL sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh)
