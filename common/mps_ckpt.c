@@ -121,16 +121,27 @@ enum mps_status mps_ckpt_get_any(struct mps_ckpt *c, const char *name, const voi
     return MPS_OK;
 }
 
-int mps_ckpt_has(const struct mps_ckpt *c, const char *name)
+int mps_ckpt_peek(const struct mps_ckpt *c, const char *name, const void **data,
+                  size_t *bytes)
 {
     const size_t nl = strlen(name);
     const char *got;
     size_t gl, at, n;
     /* a damaged image has no such block here: reading it will say why */
     for (size_t pos = 0; block_at(c, pos, &got, &gl, &at, &n) == 0; pos = at + pad8(n))
-        if (gl == nl && memcmp(got, name, nl) == 0)
+        if (gl == nl && memcmp(got, name, nl) == 0) {
+            if (data)
+                *data = c->buf + at;
+            if (bytes)
+                *bytes = n;
             return 1;
+        }
     return 0;
+}
+
+int mps_ckpt_has(const struct mps_ckpt *c, const char *name)
+{
+    return mps_ckpt_peek(c, name, NULL, NULL);
 }
 
 enum mps_status mps_ckpt_get(struct mps_ckpt *c, const char *name, void *data, size_t bytes,

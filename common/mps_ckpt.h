@@ -56,6 +56,10 @@ enum mps_status mps_ckpt_get_any(struct mps_ckpt *c, const char *name, const voi
  * does not move), 0 if not: a section a newer version adds, asked before it
  * is needed. */
 int mps_ckpt_has(const struct mps_ckpt *c, const char *name);
+/* The same, and where the block is: *data points into the image, *bytes is
+ * its size (either may be NULL). */
+int mps_ckpt_peek(const struct mps_ckpt *c, const char *name, const void **data,
+                  size_t *bytes);
 
 /* DIR/checkpoint/PREFIX_NNNNNN.ckpt into path (size len). */
 void mps_ckpt_path(char *path, size_t len, const char *dir, const char *prefix, long number);

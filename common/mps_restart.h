@@ -63,4 +63,23 @@ enum mps_status mps_run_read(struct mps_ckpt *c, const char *dir, const char *pr
 enum mps_status mps_run_get_rest(struct mps_ckpt *c, struct mps_h5_series *h5,
                                  struct mps_err *err);
 
+/* What a run's last bits depend on besides its input and the restart's
+ * state: the build and the CPU always, and for a program whose sums depend on
+ * them the OpenMP thread count and the vector paths (the fluid: its
+ * reductions and its AVX-512 paths; the solid is the same run on any count
+ * and either path). A checkpoint records them (block "arith", after "run";
+ * a checkpoint of an older build has none); a restart with other ones goes
+ * on, with the same physics, but need not be bit for bit the run it
+ * continues, and says so. A program sets what counts once, at start. */
+#define MPS_ARITH_THREADS 1u
+#define MPS_ARITH_SIMD 2u
+void mps_run_arith_set(unsigned what);
+/* After a restart's read of c: writes what differs between the arithmetic
+ * the checkpoint records and this run's into note (size len, e.g. "threads
+ * 2 -> 1, paths avx512 -> portable"), "" where nothing does or the
+ * checkpoint records none; where something does, prints a line saying so,
+ * "PROGRAM: note: PATH: ...", even under --quiet (it is about the result). */
+void mps_run_arith_check(const struct mps_ckpt *c, const char *program, const char *path,
+                         char *note, size_t len);
+
 #endif

@@ -71,6 +71,7 @@ struct run {
     double t_checkpoint;    /* wall seconds spent writing them */
     char restart_path[4400]; /* the checkpoint restarted from, or "" */
     double restart_time;
+    char restart_arith[256]; /* what differs from its run's arithmetic, or "" */
 };
 
 /* The fluid and its tank, [0, nfixed_end): a coupled solid's particles, the
@@ -166,6 +167,8 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
         mps_json_object(&j, "restart");
         mps_json_str(&j, "checkpoint", r->restart_path);
         mps_json_num(&j, "time", r->restart_time);
+        if (r->restart_arith[0])
+            mps_json_str(&j, "arith_differs", r->restart_arith);
         mps_json_close(&j);
     }
     if (r->peer.advances) {
@@ -356,6 +359,8 @@ static enum mps_status restart_or_setup(struct run *r, const struct mps_cli *cli
     /* a block out of place: a checkpoint of another build (a field added) */
     if ((st = mps_run_get_rest(&r->disk, r->h5, err)) || (st = fluid_state_get(r->f, &r->disk, err)))
         return mps_err_prefix(err, "%s: ", r->restart_path);
+    mps_run_arith_check(&r->disk, "fluid_solver", r->restart_path, r->restart_arith,
+                        sizeof r->restart_arith);
     if (!cli->quiet)
         fprintf(stderr, "fluid_solver: restarting %s at t = %.9g s (step %ld)\n", cli->restart_dir,
                 r->f->time, r->f->step);
@@ -404,6 +409,8 @@ static enum mps_status peer_resume(void *self, long number, struct mps_err *err)
     if ((st = mps_run_get_rest(&r->disk, r->h5, err)) ||
         (st = fluid_state_get(r->f, &r->disk, err)))
         return mps_err_prefix(err, "%s: ", r->restart_path);
+    mps_run_arith_check(&r->disk, "fluid_solver", r->restart_path, r->restart_arith,
+                        sizeof r->restart_arith);
     r->restart_time = r->f->time;
     return MPS_OK;
 }
@@ -528,6 +535,8 @@ int main(int argc, char **argv)
 {
     struct mps_err err = {0};
     mps_prov_init(argc, argv);
+    /* the PPE's sums and the neighbour loops' vector paths: docs/restart.md */
+    mps_run_arith_set(MPS_ARITH_THREADS | MPS_ARITH_SIMD);
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);
     const char *endpoint = NULL;

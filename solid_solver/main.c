@@ -53,6 +53,7 @@ struct run {
     double stopped_at;        /* --stop-at stopped the run here, or -1 */
     char restart_path[4400];  /* the checkpoint restarted from, or "" */
     double restart_time;
+    char restart_arith[256];  /* what differs from its run's arithmetic, or "" */
 };
 
 static enum mps_status write_checkpoint(struct run *r, const char *dir, const char *yaml,
@@ -117,6 +118,8 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
         mps_json_object(&j, "restart");
         mps_json_str(&j, "checkpoint", r->restart_path);
         mps_json_num(&j, "time", r->restart_time);
+        if (r->restart_arith[0])
+            mps_json_str(&j, "arith_differs", r->restart_arith);
         mps_json_close(&j);
     }
     double ps = (double)n * (double)steps;
@@ -240,6 +243,9 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
         mps_err_prefix(err, "%s: ", r.restart_path);
         goto done;
     }
+    if (cli->restart_dir)
+        mps_run_arith_check(&r.disk, "solid_solver", r.restart_path, r.restart_arith,
+                            sizeof r.restart_arith);
     if (!r.ops->state_put && ck_dt > 0.0) {
         st = mps_err_set(err, MPS_EINPUT, "output.checkpoint_interval = %g: the solid model %s "
                          "cannot checkpoint (set it to 0)", ck_dt, r.ops->name);

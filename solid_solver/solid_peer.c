@@ -38,6 +38,7 @@ struct peer {
     char prefix[64];
     char restart_path[4400];
     double restart_time;
+    char restart_arith[256]; /* what differs from its run's arithmetic, or "" */
     int fracture;          /* the scene has fracture or contact (solid.eps_max, solid.contact) */
 };
 
@@ -141,6 +142,8 @@ static enum mps_status resume(void *self, long number, struct mps_err *err)
     if ((st = mps_run_get_rest(&p->disk, p->h5, err)) ||
         (st = p->ops->state_get(p->model, &p->disk, err)))
         return mps_err_prefix(err, "%s: ", p->restart_path);
+    mps_run_arith_check(&p->disk, "solid_solver", p->restart_path, p->restart_arith,
+                        sizeof p->restart_arith);
     p->substeps = p->mark.steps;
     p->restart_time = p->disk.time;
     return MPS_OK;
@@ -260,6 +263,8 @@ static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const str
         mps_json_object(&j, "restart");
         mps_json_str(&j, "checkpoint", p->restart_path);
         mps_json_num(&j, "time", p->restart_time);
+        if (p->restart_arith[0])
+            mps_json_str(&j, "arith_differs", p->restart_arith);
         mps_json_close(&j);
     }
     mps_json_int(&j, "substeps", p->substeps);

@@ -170,6 +170,33 @@ restart_older_build(solid $<TARGET_FILE:coupler> "coupler: input: solid solver: 
 restart_older_build(solid_alone $<TARGET_FILE:solid_solver> solid_solver
                     solid omega cases/fracture_collision/case.yml --set dp=0.025)
 
+# A restart with other arithmetic than its checkpoint's (another thread count
+# for the fluid, its portable paths, a checkpoint of a build that recorded
+# none) goes on and says so in one note line and summary.json; with the
+# same arithmetic it says nothing and is the run bit for bit; the solid,
+# whose run no thread count or path changes, says nothing either and is the
+# run with one thread and with the portable paths (docs/restart.md, "Other
+# arithmetic")
+add_test(NAME restart_arith_fluid
+  COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/restart_arith.py ${RS_OUT}/arith_fluid
+          0.1 fluid yes $<TARGET_FILE:fluid_solver> cases/dambreak/case.yml --set dp=0.01
+          --set end_time=0.2 --set output.interval=0.05 --set output.checkpoint_interval=0.05
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+add_test(NAME restart_arith_solid
+  COMMAND /usr/bin/python3 ${CMAKE_CURRENT_LIST_DIR}/restart_arith.py ${RS_OUT}/arith_solid
+          0.2 solid no $<TARGET_FILE:solid_solver> cases/fracture_collision/case.yml
+          --set dp=0.025 --set end_time=0.4 --set output.interval=0.05
+          --set output.checkpoint_interval=0.1
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+# coupled: the fluid's note reaches the user through the coupler, and its
+# summary records it
+add_test(NAME restart_arith_coupled
+  COMMAND sh -c "o=\"$1\"; rm -rf \"$o\" && OMP_NUM_THREADS=2 \"$0\" tests/coupler/plate_in_water.yml --out \"$o\" --quiet --set end_time=0.1 --set output.interval=0 --set output.checkpoint_interval=0.05 --stop-at 0.05 && OMP_NUM_THREADS=1 \"$0\" --restart \"$o\" --quiet 2>\"$o.err\" && grep -q '^fluid_solver: note: .*fluid_000001.ckpt was written with other arithmetic (threads 2 -> 1' \"$o.err\" && grep -q '\"arith_differs\": *\"threads 2 -> 1\"' \"$o\"/fluid_summary.json"
+          $<TARGET_FILE:coupler> ${RS_OUT}/arith_coupled
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(restart_arith_fluid restart_arith_solid restart_arith_coupled PROPERTIES
+  TIMEOUT 120 LABELS integration)
+
 # Bad restarts: one clear line, exit 2 (tests/expect_fail.sh)
 set(RS_FAIL sh ${CMAKE_SOURCE_DIR}/tests/expect_fail.sh)
 function(restart_bad name pattern)

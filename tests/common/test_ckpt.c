@@ -43,6 +43,13 @@ static void image(void)
     CHECK(mps_ckpt_has(&c, "a") && mps_ckpt_has(&c, "bee") && mps_ckpt_has(&c, "empty"));
     CHECK(!mps_ckpt_has(&c, "be") && !mps_ckpt_has(&c, "beee") && !mps_ckpt_has(&c, "more"));
     CHECK(mps_ckpt_get(&c, "bee", &rb, sizeof rb, &err) == MPS_OK); /* pos did not move */
+    /* and where it is, read in place (the restart's record of its arithmetic) */
+    const void *q = NULL;
+    size_t qn = 0;
+    CHECK(mps_ckpt_peek(&c, "bee", &q, &qn) && qn == sizeof rb && *(const int *)q == 7);
+    CHECK(mps_ckpt_peek(&c, "empty", &q, &qn) && qn == 0);
+    CHECK(!mps_ckpt_peek(&c, "more", &q, &qn) && qn == 0);
+    CHECK(mps_ckpt_get_any(&c, "empty", &p, &n, &err) == MPS_OK); /* pos did not move */
     mps_ckpt_free(&c);
 }
 
