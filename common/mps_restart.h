@@ -78,7 +78,8 @@ void mps_run_arith_set(unsigned what);
  * the checkpoint records and this run's into note (size len, e.g. "threads
  * 2 -> 1, paths avx512 -> portable"), "" where nothing does or the
  * checkpoint records none; where something does, prints a line saying so,
- * "PROGRAM: note: PATH: ...", even under --quiet (it is about the result). */
+ * "PROGRAM: note: PATH was written with other arithmetic (NOTE): ...", even
+ * under --quiet (it is about the result). */
 void mps_run_arith_check(const struct mps_ckpt *c, const char *program, const char *path,
                          char *note, size_t len);
 
