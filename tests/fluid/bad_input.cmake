@@ -18,7 +18,7 @@ fluid_expect_fail(fluid_bad_negative_dp "dp = -0.004: must be > 0"
                   ${FS} ${DB} ${OUT} --set dp=-0.004)
 fluid_expect_fail(fluid_bad_block_outside "fluid.blocks.0.x1 = 0.7: the water block lies outside the tank"
                   ${FS} ${DB} ${OUT} --set fluid.blocks.0.x1=0.7)
-fluid_expect_fail(fluid_bad_end_time_zero "end_time = 0: must be > 0"
+fluid_expect_fail(fluid_bad_end_time_zero "end_time = 0: must be in \\(0, 10000\\]"
                   ${FS} ${DB} ${OUT} --set end_time=0)
 fluid_expect_fail(fluid_bad_cfl "fluid.dt_min = 0.01: the CFL condition \\(Eq. 52\\) needs dt <="
                   ${FS} ${DB} ${OUT} --set fluid.dt_min=0.01 --set fluid.dt_max=0.02)
