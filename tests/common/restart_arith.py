@@ -85,7 +85,7 @@ def one_note(name, notes, rs, want):
     if not (PREFIX + "_0" in line and ".ckpt was written with other arithmetic (" + want in line
             and "docs/restart.md" in line):
         fail("%s: the note does not name the checkpoint and '%s': %s" % (name, want, line))
-    if rs.get("arith_differs") != want and not rs.get("arith_differs", "").startswith(want):
+    if not rs.get("arith_differs", "").startswith(want):
         fail("%s: summary.json restart.arith_differs = %r, expected %r"
              % (name, rs.get("arith_differs"), want))
 
