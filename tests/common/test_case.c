@@ -240,7 +240,7 @@ static void test_errors(void)
                  "did you mean fluid.blocks.1.x0?", NULL);
     /* one line however many problems: the first, the count, the next */
     expect_error("dp: -1\nend_time: 0\ngravity: {x: a}\n", NULL, 0, "@:1: dp = -1: must be > 0",
-                 "(and 2 more problems; the next: @:2: end_time = 0: must be > 0)", NULL);
+                 "(and 2 more problems; the next: @:2: end_time = 0: must be in (0, 10000])", NULL);
     expect_error("dp: 0.01\nend_tmie: 1\n", NULL, 0, "@:2: end_tmie = 1: unknown key",
                  "did you mean end_time?", "@: missing required key 'end_time'");
     expect_error("dp: 0.01\nend_time: 1\nzzz: 1\n", NULL, 0, "@:3: zzz = 1: unknown key", NULL,
@@ -279,7 +279,7 @@ static void test_errors(void)
 
     /* several problems are reported together */
     expect_error("dp: -1\nend_time: 0\n", NULL, 0, "@:1: dp = -1: must be > 0",
-                 "@:2: end_time = 0: must be > 0", NULL);
+                 "@:2: end_time = 0: must be in (0, 10000]", NULL);
 
     expect_error("dp: [1, 2\nend_time: 1\n", NULL, 0, "YAML syntax error", "@:", NULL);
     expect_error("dp: 1\n  end_time: 1\n", NULL, 0, "@:2: YAML syntax error:", NULL, NULL);
