@@ -731,6 +731,17 @@ static enum mps_status check_domain(const struct fluid *f, struct mps_err *err)
     return MPS_OK;
 }
 
+enum mps_status fluid_check_step(const struct fluid *f, double dt, struct mps_err *err)
+{
+    if (!(dt > 0.0) || dt < f->prm.dt_min)
+        return mps_err_set(err, MPS_EDIVERGED,
+                           "fluid step %.3g s at t = %.6g s is below fluid.dt_min = %.3g s: the "
+                           "flow, or a solid's surface in it, is too fast for the CFL condition "
+                           "(Eq. 52)",
+                           dt, f->time, f->prm.dt_min);
+    return MPS_OK;
+}
+
 enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
 {
     const struct fluid_params *p = &f->prm;
@@ -738,11 +749,8 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
     const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])f->x;
     enum mps_status st;
 
-    if (!(dt > 0.0) || dt < p->dt_min)
-        return mps_err_set(err, MPS_EDIVERGED,
-                           "fluid step %.3g s at t = %.6g s is below fluid.dt_min = %.3g s: the "
-                           "flow is too fast for the CFL condition (Eq. 52)",
-                           dt, f->time, p->dt_min);
+    if ((st = fluid_check_step(f, dt, err)))
+        return st;
 
     /* the step the CFL condition allows here: a step shortened below it
      * (the last one, landing on end_time) scales Eq. 23's correction with

@@ -174,6 +174,11 @@ void fluid_destroy(struct fluid **f);
 /* The step the CFL condition (Eq. 52) allows now, capped by dt_max. */
 double fluid_cfl_dt(const struct fluid *f);
 
+/* MPS_EDIVERGED, saying so, if a step of dt is below fluid.dt_min (or zero:
+ * a speed that overflowed). Checked before a step, and before the fluid
+ * offers its next step to a coupler, where a zero cannot go on the wire. */
+enum mps_status fluid_check_step(const struct fluid *f, double dt, struct mps_err *err);
+
 /* One step of dt (Eq. 16-24). Fails with MPS_EDIVERGED on NaN or a particle
  * leaving the domain, MPS_ESOLVE if the PPE solve fails. */
 enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err);

@@ -10,7 +10,10 @@
 #define POS (MPS_KEY_LO_OPEN | MPS_KEY_NO_HI)
 
 const struct mps_key_spec fluid_case_keys[] = {
-    {"fluid.rho", MPS_KEY_DOUBLE, "1000", 0, 0, POS, NULL, "kg/m^3", "water density"},
+    /* bounded above (no liquid is denser than 2.3e4 kg/m^3) because 1e300
+     * overflowed the PPE's right-hand side to a non-finite residual */
+    {"fluid.rho", MPS_KEY_DOUBLE, "1000", 0, 1e5, MPS_KEY_LO_OPEN, NULL, "kg/m^3",
+     "water density"},
     {"fluid.nu", MPS_KEY_DOUBLE, "1e-6", 0, 0, NOHI, NULL, "m^2/s", "kinematic viscosity"},
     {"fluid.courant", MPS_KEY_DOUBLE, "0.2", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "Courant number C of Eq. 52"},
@@ -84,11 +87,16 @@ const struct mps_key_spec fluid_case_keys[] = {
      "(1 - r/re)^2 with the particle itself (quadratic), which disorder raises a third as "
      "much, so that still water neither pairs up nor expands (docs/pressure.md); the free "
      "surface check keeps Eq. 7's"},
-    {"fluid.alpha", MPS_KEY_DOUBLE, "1e-7", 0, 0, NOHI, NULL, "1/Pa",
+    /* 1e-3 1/Pa is a sound speed of 1 m/s in water, slower than the flows
+     * here: past it the compressibility is the flow, not a correction to it
+     * (and 1e300 overflowed the PPE's diagonal) */
+    {"fluid.alpha", MPS_KEY_DOUBLE, "1e-7", 0, 1e-3, 0, NULL, "1/Pa",
      "compressibility 1/(rho c^2) of the weakly compressible PPE (Eq. 21-23)"},
-    {"fluid.re_n", MPS_KEY_DOUBLE, "2.1", 1, 0, POS, NULL, "dp",
+    /* 10 dp is far past the paper's 2.1 and 4.0, and a weight spanning a
+     * whole thin body; 1e300 overflowed the weights' sums to NaN positions */
+    {"fluid.re_n", MPS_KEY_DOUBLE, "2.1", 1, 10, MPS_KEY_LO_OPEN, NULL, "dp",
      "effective radius for number density and gradient"},
-    {"fluid.re_lap", MPS_KEY_DOUBLE, "4.0", 1, 0, POS, NULL, "dp",
+    {"fluid.re_lap", MPS_KEY_DOUBLE, "4.0", 1, 10, MPS_KEY_LO_OPEN, NULL, "dp",
      "effective radius for the Laplacian"},
     {"fluid.beta1", MPS_KEY_DOUBLE, "0.97", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
      "free surface if n < beta1 n0 ..."},

@@ -420,6 +420,9 @@ static enum mps_status peer_ready(void *self, struct proto_msg *reply, struct mp
     struct run *r = self;
     reply->payload = PROTO_NONE;
     reply->dt = fluid_cfl_dt(r->f);
+    enum mps_status st = fluid_check_step(r->f, reply->dt, err);
+    if (st)
+        return st;
     reply->nprobes = r->f->prm.nprobes;
     reply->text = r->probe_names[0] ? r->probe_names : NULL;
     return MPS_OK;
@@ -464,6 +467,8 @@ static enum mps_status peer_advance(void *self, const struct proto_msg *in,
     reply->pressure = r->load_p;
     reply->force = (const double(*)[MPS_DIM])r->load_f;
     reply->dt = fluid_cfl_dt(f);
+    if ((st = fluid_check_step(f, reply->dt, err)))
+        return st;
     if (in->flags & PROTO_F_PROBES) {
         static double values[FLUID_MAX_PROBES];
         for (int k = 0; k < f->prm.nprobes; k++)

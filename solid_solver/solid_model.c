@@ -2,6 +2,7 @@
  * house style: a scene picks one by name, --model or solid.model). */
 #include "solid_model.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -50,5 +51,34 @@ enum mps_status solid_model_open(const struct solid_model_ops **ops, void **self
     enum mps_status st = (*ops)->create(self, c, err);
     if (st == MPS_OK && mps_case_int(c, "solid.refine") > 1)
         st = solid_refine_wrap(ops, self, c, err);
-    return st;
+    if (st != MPS_OK)
+        return st;
+    /* An absurd material (rho = 1e-300 kg/m^3 underflows the rotation's
+     * inertia to a zero step; E = 1e300 Pa asks 1e149 steps) is refused here,
+     * where the case is still at hand: before, the standalone loop's step
+     * count overflowed and the run "finished" at once with exit 0, and a
+     * coupled one failed as a protocol error on READY's dt = 0. */
+    const double dt = (*ops)->stable_dt(*self), end = mps_case_double(c, "end_time");
+    if (dt > 0.0 && end / dt <= SOLID_MAX_STEPS)
+        return MPS_OK;
+    /* named at the stiffest body for its mass, whose wave sets the step */
+    int worst = 0;
+    double most = -1.0;
+    for (int b = 0; b < mps_case_count(c, "solid.bodies"); b++) {
+        double ratio = mps_case_double(c, "solid.bodies.%d.E", b) /
+                       mps_case_double(c, "solid.bodies.%d.rho", b);
+        if (!(ratio <= most)) {
+            most = ratio;
+            worst = b;
+        }
+    }
+    char key[48];
+    snprintf(key, sizeof key, "solid.bodies.%d.E", worst);
+    return mps_case_fail(c, err, key,
+                         "with rho = %g kg/m^3 and dp = %g m the solid's stable step is %.3g s, "
+                         "%.3g steps to end_time = %g s (more than %.0e): check the body's E "
+                         "and rho",
+                         mps_case_double(c, "solid.bodies.%d.rho", worst),
+                         mps_case_double(c, "dp"), dt, dt > 0.0 ? ceil(end / dt) : INFINITY, end,
+                         SOLID_MAX_STEPS);
 }

@@ -112,9 +112,16 @@ enum mps_status solid_model_snapshot(const struct solid_model_ops *ops, void *mo
                                      struct mps_h5_series *h5, double t, long step,
                                      double *seconds, struct mps_err *err);
 
+/* The most steps to end_time a solid may ask for: at the fastest 100 ns a
+ * step (one particle) 1e12 steps are more than a day of computing, and every
+ * count stays exact in a double and far inside a long. */
+#define SOLID_MAX_STEPS 1e12
+
 /* Creates the model *ops names from the case; with solid.refine > 1 wraps it
  * in the refinement (solid_refine.h) and points *ops at the wrapper, which
- * every later call goes through. */
+ * every later call goes through. A stable step that is zero, or that needs
+ * more than SOLID_MAX_STEPS steps to end_time, is an input error naming the
+ * case. */
 enum mps_status solid_model_open(const struct solid_model_ops **ops, void **self,
                                  const struct mps_case *c, struct mps_err *err);
 

@@ -37,7 +37,9 @@ const struct mps_key_spec solid_case_keys[] = {
      "factor on E in 2D: the bending stiffness of the 3D body over that of the plane chosen, "
      "for a strip whose breadth and clamp put it between the planes "
      "(bench/plate_3d_stiffness.py); 1 = the plane as it is"},
-    {"solid.interface_depth", MPS_KEY_DOUBLE, "2.1", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
+    /* at least half a spacing: any depth under one sends the surface layer
+     * alone, and 1e-300 dp made a grid of 1e300 cells */
+    {"solid.interface_depth", MPS_KEY_DOUBLE, "2.1", 0.5, 0, MPS_KEY_NO_HI, NULL,
      "dp", "inner particles within this depth of the surface are sent to a coupled fluid (its "
      "number-density radius)"},
     /* No defaults: a scene that sets neither has no fracture and no contact,

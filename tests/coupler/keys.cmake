@@ -32,3 +32,20 @@ keys_expect_fail(coupler_mps_refuses_python_key
 keys_expect_fail(coupler_implicit_fracture
   "^coupler: --set coupling.scheme=implicit: coupling.scheme = implicit: implicit coupling cannot be used with fracture or contact \\(solid.eps_max, solid.contact\\): the interface would change within a step$"
   tests/coupler/plate_in_water.yml --set solid.eps_max=0.1 --set coupling.scheme=implicit)
+# A solid whose stable step needs more sub-steps than an ADVANCE carries: our
+# MPS solid refuses such a case itself (tests/cases_broken/MANIFEST), so the
+# coupler's own check, which guards any solid, is tried on the Python one.
+keys_expect_fail(coupler_python_stable_step
+  "^coupler: tests/coupler/plate_in_water.yml: the solid's stable step [0-9.e+-]+ s needs [0-9.e+]+ sub-steps for a coupling step of 0.001 s, more than an ADVANCE carries \\(2147483647\\): check the solid's E, rho and dp$"
+  tests/coupler/plate_in_water.yml --quiet --solid ${PY_SOLID} --set solid.bodies.0.E=1e30)
+# A solid surface moving at 1e300 m/s: the fluid's CFL step overflowed to 0,
+# which it offered the coupler and the protocol refused ("RESULT: dt = 0");
+# now the fluid says its step is below fluid.dt_min, as for a flow too fast.
+add_test(NAME coupler_solid_speed_overflow
+  COMMAND sh ${CMAKE_SOURCE_DIR}/tests/expect_status.sh 1
+          "^coupler: diverged: fluid solver: diverged: fluid step 0 s at t = 0.001 s is below fluid.dt_min = 1e-07 s: the flow, or a solid's surface in it, is too fast"
+          ${CMAKE_BINARY_DIR}/bin/coupler cases/dambreak_elastic_plate/case.yml --quiet
+          --set dp=0.006 --set solid.bodies.0.vx=1e300 --set end_time=0.01
+          --out ${CMAKE_BINARY_DIR}/test_out/keys_solid_speed_overflow
+  WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(coupler_solid_speed_overflow PROPERTIES TIMEOUT 60 LABELS unit)
