@@ -202,6 +202,38 @@ void case_finish_errs(struct errs *es)
 
 /* ---- load ---- */
 
+/* Every program lands on each snapshot, probe and checkpoint time in turn.
+ * An interval so short that end_time holds more than MPS_CASE_MAX_EVENTS of
+ * them is refused: at 1e-300 s the loops stepped by nothing (t + 1e-300 ==
+ * t) and the solid, or the coupler of a solid alone, never finished. 1e8 is
+ * far past any output a run can write (probes.csv at 1e8 rows is ~10 GB) and
+ * keeps every interval above 1e-8 end_time, far above a double's rounding. */
+#define MPS_CASE_MAX_EVENTS 1e8
+
+static enum mps_status case_check_events(const struct mps_case *c, struct mps_err *err)
+{
+    static const struct {
+        const char *key, *what, *hint;
+    } events[] = {{"output.interval", "snapshots", ", or 0 for none"},
+                  {"output.probe_interval", "probes.csv rows", ""},
+                  {"output.checkpoint_interval", "checkpoints", ", or 0 for none"}};
+    if (!case_find_spec(c, "end_time"))
+        return MPS_OK; /* a table without the common keys (tests) */
+    const double end = mps_case_double(c, "end_time");
+    for (size_t k = 0; k < sizeof events / sizeof events[0]; k++) {
+        if (!case_find_spec(c, events[k].key))
+            continue;
+        double dt = mps_case_double(c, "%s", events[k].key);
+        if (dt > 0.0 && end / dt > MPS_CASE_MAX_EVENTS)
+            return mps_case_fail(c, err, events[k].key,
+                                 "%.3g %s to end_time = %g s, more than %.0e: give a "
+                                 "longer interval%s",
+                                 end / dt, events[k].what, end, MPS_CASE_MAX_EVENTS,
+                                 events[k].hint);
+    }
+    return MPS_OK;
+}
+
 enum mps_status mps_case_load(struct mps_case **out, const char *path,
                               const char *const *sets, int nsets,
                               const struct mps_key_spec *const *spec_tables, int ntables,
@@ -239,6 +271,8 @@ enum mps_status mps_case_load(struct mps_case **out, const char *path,
         st = MPS_EINPUT;
         case_finish_errs(&es);
     }
+    if (st == MPS_OK)
+        st = case_check_events(c, err);
     if (st != MPS_OK && err)
         case_one_line(err->msg);
     if (st != MPS_OK) {

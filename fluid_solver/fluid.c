@@ -156,6 +156,18 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
             goto fail;
         }
         const double omega = 6.283185307179586 / period;
+        /* the model is of thin layers on the two walls; layers that fill the
+         * breadth (a period of 1e300 s, a breadth of 1e-300 m) made an
+         * infinite inertia and a non-finite PPE */
+        const double delta = sqrt(2.0 * prm->nu / omega);
+        if (!(delta < 0.5 * prm->side_wall_breadth)) {
+            st = mps_err_set(err, MPS_EINPUT,
+                             "fluid.side_walls.breadth = %g m: the side walls' boundary layers, "
+                             "delta = sqrt(2 nu / omega) = %.3g m at a period of %g s, fill it; "
+                             "the model holds while delta < breadth / 2",
+                             prm->side_wall_breadth, delta, period);
+            goto fail;
+        }
         f->side_wall_rate = sqrt(2.0 * prm->nu * omega) / prm->side_wall_breadth;
         if (prm->side_wall_inertia)
             f->side_wall_inertia = sqrt(2.0 * prm->nu / omega) / prm->side_wall_breadth;

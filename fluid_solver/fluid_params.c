@@ -98,9 +98,12 @@ const struct mps_key_spec fluid_case_keys[] = {
      "effective radius for number density and gradient"},
     {"fluid.re_lap", MPS_KEY_DOUBLE, "4.0", 1, 10, MPS_KEY_LO_OPEN, NULL, "dp",
      "effective radius for the Laplacian"},
-    {"fluid.beta1", MPS_KEY_DOUBLE, "0.97", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+    /* at least 0.5 (the paper: 0.97, 0.85): below it a particle missing half
+     * its neighbours counts as inside, and with no free-surface row at all
+     * (1e-300) the PPE failed as not positive definite */
+    {"fluid.beta1", MPS_KEY_DOUBLE, "0.97", 0.5, 1, 0, NULL, "",
      "free surface if n < beta1 n0 ..."},
-    {"fluid.beta2", MPS_KEY_DOUBLE, "0.85", 0, 1, MPS_KEY_LO_OPEN, NULL, "",
+    {"fluid.beta2", MPS_KEY_DOUBLE, "0.85", 0.5, 1, 0, NULL, "",
      "... and neighbour count < beta2 N0"},
     {"fluid.surface_scan", MPS_KEY_DOUBLE, "1.15", 0, 1.4, 0, NULL, "dp",
      "a free-surface candidate stays one only if no neighbour lies within this distance "

@@ -67,3 +67,10 @@ fluid_expect_fail(coupler_bad_fluid_without_fluid "coupler: --fluid fluid_solver
                   ${CMAKE_BINARY_DIR}/bin/coupler cases/cantilever_beam/case.yml ${OUT} --fluid fluid_solver)
 fluid_expect_fail(coupler_bad_external_unneeded "coupler: --external solid: cases/dambreak/case.yml has no solid"
                   ${CMAKE_BINARY_DIR}/bin/coupler ${DB} ${OUT} --external solid)
+# The side walls' Stokes layers must be thin against the breadth: layers that
+# filled it (a breadth of 1e-300 m) made an infinite inertia and a PPE with a
+# non-finite residual, reported as a solver failure.
+fluid_expect_fail(fluid_bad_side_walls_thick_layers
+                  "^fluid_solver: input: fluid.side_walls.breadth = 0.005 m: the side walls' boundary layers, delta = sqrt\\(2 nu / omega\\) = 0.00512 m at a period of 1.64656 s, fill it; the model holds while delta < breadth / 2$"
+                  ${FS} cases/sloshing_low/case.yml ${OUT} --quiet --set dp=0.004
+                  --set end_time=0.01 --set fluid.side_walls.breadth=0.005)

@@ -766,8 +766,10 @@ FAULTS = [
       hint='coupler_fluid_fails|broken_case_files|restart_bad_solver_checkpoint_damaged'),
     # ---- the solvers own their keys (issue 22, PROTOCOL.md 8: case errors) ----
     F(id='case_error_unmarked', eq='PROTOCOL.md 8: case error', file='solid_solver/solid_peer.c',
-      old='        return proto_solver_case_error(st, err);',
-      new='        return st; /* unmarked */',
+      old='''    if (st)
+        return proto_solver_case_error(st, err);''',
+      new='''    if (st)
+        return st; /* unmarked */''',
       what="the solid answers a problem with its keys as a plain input error: the user gets "
            "the coupler's and the solid's lines, not the one line naming file, line and key",
       hint='broken_case_files'),
