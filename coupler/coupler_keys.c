@@ -2,12 +2,15 @@
 
 #include "mps_motion.h"
 
+/* The deadlines are at most 1e6 s (11 days: no deadline at all in practice)
+ * because the solvers get them in milliseconds on CONFIG, where 1e300 s was
+ * a 304-digit number that overflowed their counts. */
 const struct mps_key_spec coupler_case_keys[] = {
-    {"coupling.hello_timeout", MPS_KEY_DOUBLE, "60", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI, NULL,
+    {"coupling.hello_timeout", MPS_KEY_DOUBLE, "60", 0, 1e6, MPS_KEY_LO_OPEN, NULL,
      "s", "deadline for a launched solver to connect"},
-    {"coupling.ready_timeout", MPS_KEY_DOUBLE, "600", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI,
+    {"coupling.ready_timeout", MPS_KEY_DOUBLE, "600", 0, 1e6, MPS_KEY_LO_OPEN,
      NULL, "s", "deadline for a solver to build its scene"},
-    {"coupling.step_timeout", MPS_KEY_DOUBLE, "600", 0, 0, MPS_KEY_LO_OPEN | MPS_KEY_NO_HI,
+    {"coupling.step_timeout", MPS_KEY_DOUBLE, "600", 0, 1e6, MPS_KEY_LO_OPEN,
      NULL, "s", "deadline for a solver to answer one ADVANCE"},
     {"coupling.transport", MPS_KEY_ENUM, "ipc", 0, 0, 0, "ipc|tcp", "",
      "ipc:// in a private run directory, or tcp:// (solvers on other hosts)"},
