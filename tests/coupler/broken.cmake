@@ -14,3 +14,12 @@ add_test(NAME coupler_lattice_warnings
                  ${CMAKE_BINARY_DIR}/bin/coupler ${CMAKE_BINARY_DIR}/test_out/lattice_warnings
          WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
 set_tests_properties(coupler_lattice_warnings PROPERTIES TIMEOUT 120 LABELS unit)
+
+# Every number key at 0, +-1e300 and 1e-300 in each program: refused, run or
+# failed with the solver's own message, never a hang, a signal or a protocol
+# error (tests/cases_broken/sweep_numbers.py; 752 runs, about 70 s on 2 cores).
+add_test(NAME broken_number_sweep
+         COMMAND /usr/bin/python3 ${CMAKE_SOURCE_DIR}/tests/cases_broken/sweep_numbers.py
+                 ${CMAKE_BINARY_DIR}/bin
+         WORKING_DIRECTORY ${CMAKE_SOURCE_DIR})
+set_tests_properties(broken_number_sweep PROPERTIES TIMEOUT 600 LABELS unit)
