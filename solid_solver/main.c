@@ -200,7 +200,8 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
         st = mps_err_set(err, MPS_EINPUT, "missing --out DIR (see --help)");
         goto done;
     }
-    if ((st = solid_model_open(&r.ops, &r.model, c, err)) != MPS_OK)
+    if ((st = solid_model_open(&r.ops, &r.model, c, err)) != MPS_OK ||
+        (st = solid_model_check_step(r.ops, r.model, c, err)) != MPS_OK)
         goto done;
     if ((st = mps_mkdir_p(cli->out_dir, err)) != MPS_OK)
         goto done;

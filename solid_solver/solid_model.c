@@ -51,14 +51,18 @@ enum mps_status solid_model_open(const struct solid_model_ops **ops, void **self
     enum mps_status st = (*ops)->create(self, c, err);
     if (st == MPS_OK && mps_case_int(c, "solid.refine") > 1)
         st = solid_refine_wrap(ops, self, c, err);
-    if (st != MPS_OK)
-        return st;
+    return st;
+}
+
+enum mps_status solid_model_check_step(const struct solid_model_ops *ops, const void *self,
+                                       const struct mps_case *c, struct mps_err *err)
+{
     /* An absurd material (rho = 1e-300 kg/m^3 underflows the rotation's
      * inertia to a zero step; E = 1e300 Pa asks 1e149 steps) is refused here,
      * where the case is still at hand: before, the standalone loop's step
      * count overflowed and the run "finished" at once with exit 0, and a
      * coupled one failed as a protocol error on READY's dt = 0. */
-    const double dt = (*ops)->stable_dt(*self), end = mps_case_double(c, "end_time");
+    const double dt = ops->stable_dt(self), end = mps_case_double(c, "end_time");
     if (dt > 0.0 && end / dt <= SOLID_MAX_STEPS)
         return MPS_OK;
     /* named at the stiffest body for its mass, whose wave sets the step */

@@ -119,11 +119,15 @@ enum mps_status solid_model_snapshot(const struct solid_model_ops *ops, void *mo
 
 /* Creates the model *ops names from the case; with solid.refine > 1 wraps it
  * in the refinement (solid_refine.h) and points *ops at the wrapper, which
- * every later call goes through. A stable step that is zero, or that needs
- * more than SOLID_MAX_STEPS steps to end_time, is an input error naming the
- * case. */
+ * every later call goes through. */
 enum mps_status solid_model_open(const struct solid_model_ops **ops, void **self,
                                  const struct mps_case *c, struct mps_err *err);
+
+/* MPS_EINPUT, naming the stiffest body's E where it was given (a problem of
+ * the case's keys: PROTOCOL.md 8's case error), if the model's stable step
+ * is zero or needs more than SOLID_MAX_STEPS steps to end_time. */
+enum mps_status solid_model_check_step(const struct solid_model_ops *ops, const void *self,
+                                       const struct mps_case *c, struct mps_err *err);
 
 /* The models compiled in, by name; NULL if unknown. */
 const struct solid_model_ops *solid_model_find(const char *name);

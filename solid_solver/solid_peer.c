@@ -97,6 +97,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
         return mps_case_fail(p->cs, err, "solid.model", "unknown model (known: %s)",
                              solid_model_names());
     if ((st = solid_model_open(&p->ops, &p->model, p->cs, err)))
+        return st;
+    if ((st = solid_model_check_step(p->ops, p->model, p->cs, err)))
         return proto_solver_case_error(st, err);
     p->depth = mps_case_double(p->cs, "solid.interface_depth") * mps_case_double(p->cs, "dp");
     int n = p->ops->probe_count(p->model);
