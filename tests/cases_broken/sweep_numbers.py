@@ -10,7 +10,7 @@ unheard), a standalone solid that "finished" at once with exit 0 when its
 step count overflowed, and keys whose absurd values ran into NaN or a
 non-finite PPE (docs/security.md, "Broken case files").
 
-usage: sweep_numbers.py BIN_DIR [--jobs N]
+usage: sweep_numbers.py BIN_DIR [--jobs N] [--deadline S]
 """
 import argparse
 import concurrent.futures
@@ -69,7 +69,7 @@ RUNS = [
 DEADLINE = 30  # s: a hang is what is looked for, and a run of these takes < 2 s
 
 
-def one(bin_dir, out_root, prog, case, base, key, value):
+def one(bin_dir, out_root, deadline, prog, case, base, key, value):
     tag = f'{prog} {case} {key}={value}'
     out = os.path.join(out_root, f'{prog}-{os.path.basename(os.path.dirname(case))}-{key}={value}')
     cmd = [os.path.join(bin_dir, prog), case, '--out', out, '--quiet']
@@ -78,11 +78,11 @@ def one(bin_dir, out_root, prog, case, base, key, value):
     p = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True,
                          errors='replace', start_new_session=True)
     try:
-        _, err = p.communicate(timeout=DEADLINE)
+        _, err = p.communicate(timeout=deadline)
     except subprocess.TimeoutExpired:
         os.killpg(p.pid, signal.SIGKILL)  # its solvers too
         p.communicate()
-        return tag, f'no end within {DEADLINE} s (killed)'
+        return tag, f'no end within {deadline} s (killed)'
     last = err.strip().splitlines()[-1] if err.strip() else ''
     if p.returncode < 0:
         return tag, f'killed by signal {-p.returncode}: {last}'
@@ -92,6 +92,10 @@ def one(bin_dir, out_root, prog, case, base, key, value):
         return tag, f'exit {p.returncode} with nothing on stderr'
     if 'protocol:' in err:
         return tag, f'a protocol error from a case value: {last}'
+    # a sanitizer build's reports (build-debug): UBSan goes on after its line
+    for line in err.splitlines():
+        if 'runtime error:' in line or 'Sanitizer' in line:
+            return tag, f'sanitizer: {line.strip()[:300]}'
     return tag, None
 
 
@@ -99,13 +103,15 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('bin_dir')
     ap.add_argument('--jobs', type=int, default=2)
+    ap.add_argument('--deadline', type=float, default=DEADLINE,
+                    help='seconds a run may take (more for a sanitizer build)')
     a = ap.parse_args()
     out_root = tempfile.mkdtemp(prefix='sweep_numbers_')
     jobs = [(prog, case, base, key, v) for prog, case, base, keys in RUNS
             for key in keys for v in VALUES]
     bad = []
     with concurrent.futures.ThreadPoolExecutor(a.jobs) as ex:
-        for tag, why in ex.map(lambda j: one(a.bin_dir, out_root, *j), jobs):
+        for tag, why in ex.map(lambda j: one(a.bin_dir, out_root, a.deadline, *j), jobs):
             if why:
                 bad.append(tag)
                 print(f'FAIL  {tag}: {why}')
