@@ -55,6 +55,8 @@ NEVER = [
     (re.compile(r'^(MPS_WERROR=ON )?\./setup\.sh --debug$', re.M), 'true',
      'builds the sanitizer build (build-debug/): .ci/run runs MPS_WERROR=ON ./setup.sh --debug '
      'itself'),
+    (re.compile(r'^.*\bbuild-debug/bin\b.*$', re.M), 'true',
+     'runs the sanitizer build, which this test does not build (.ci/run builds it)'),
 ]
 
 # (file, pattern, Python module, reason): run only where the module imports
