@@ -12,6 +12,7 @@
 #define MPS_CASE_H
 
 #include <stddef.h>
+#include <stdio.h>
 
 #include "mps_err.h"
 #include "mps_utf8.h"
@@ -122,7 +123,14 @@ char *mps_case_resolved_yaml(const struct mps_case *c);
 enum mps_status mps_case_write_resolved(const struct mps_case *c, const char *path,
                                         const char *comment, struct mps_err *err);
 
+/* Prints the spec tables as Markdown (--keys): a "## TITLE" section per
+ * table (titles[t]), a line per key with its type, units, default, bounds
+ * and help. */
+void mps_case_print_keys(FILE *f, const struct mps_key_spec *const *tables,
+                         const char *const *titles, int ntables);
+
 /* Specs every program shares: dp, end_time, gravity, output.*. */
 extern const struct mps_key_spec mps_case_common_keys[];
+#define MPS_CASE_COMMON_KEYS_TITLE "Every program: the run, gravity, output"
 
 #endif

@@ -16,7 +16,7 @@ const char *case_shown(const char *v)
     return *v ? v : "(empty)";
 }
 
-static void bounds_text(const struct mps_key_spec *s, char *buf, size_t n)
+void case_bounds_text(const struct mps_key_spec *s, char *buf, size_t n)
 {
     int lo = !(s->flags & MPS_KEY_NO_LO), hi = !(s->flags & MPS_KEY_NO_HI);
     int lo_open = !!(s->flags & MPS_KEY_LO_OPEN), hi_open = !!(s->flags & MPS_KEY_HI_OPEN);
@@ -60,7 +60,7 @@ int case_check_value(const struct mps_key_spec *s, const char *text, struct valu
             return -1;
         }
         if (!in_bounds(s, v->d)) {
-            bounds_text(s, prob, np);
+            case_bounds_text(s, prob, np);
             return -1;
         }
         return 0;
@@ -77,7 +77,7 @@ int case_check_value(const struct mps_key_spec *s, const char *text, struct valu
         }
         v->d = (double)v->i;
         if (!in_bounds(s, v->d)) {
-            bounds_text(s, prob, np);
+            case_bounds_text(s, prob, np);
             return -1;
         }
         return 0;

@@ -90,6 +90,8 @@ void case_finish_errs(struct errs *es);
 /* ---- values and specs (mps_case_keys.c) ---- */
 /* v, or "(empty)" */
 const char *case_shown(const char *v);
+/* "must be in [0, 1]", "must be > 0", or "out of range" (no bounds). */
+void case_bounds_text(const struct mps_key_spec *s, char *buf, size_t n);
 /* Parses text as the spec's type and checks its bounds. Returns 0, or -1
  * with the problem ("must be > 0") in prob. */
 int case_check_value(const struct mps_key_spec *s, const char *text, struct value *v, char *prob,

@@ -24,6 +24,8 @@ static void print_help(const char *usage, const struct mps_cli_extra *extra, int
            "  --from TIME          with --restart: from the checkpoint nearest to TIME\n"
            "  --stop-at TIME       stop at the first checkpoint at or after TIME (s)\n"
            "  --version            show the version and git revision it was built from\n"
+           "  --keys               list every case key this program reads, with its type,\n"
+           "                       default, bounds and meaning (Markdown; docs/keys.md)\n"
            "  --help               show this help\n");
     for (int k = 0; k < nextra; k++) {
         char head[128];
@@ -79,6 +81,10 @@ enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) {
             print_help(usage, extra, nextra);
             return mps_err_set(err, MPS_EINTR, "help shown");
+        }
+        if (!strcmp(argv[i], "--keys")) {
+            cli->keys = 1;
+            return mps_err_set(err, MPS_EINTR, "keys asked");
         }
         if (!strcmp(argv[i], "--version")) {
             const char *slash = strrchr(argv[0], '/');

@@ -32,11 +32,13 @@ struct mps_cli {
     const char *restart_dir;      /* --restart DIR (then out_dir = DIR, no case_path) */
     double restart_from;          /* --from T, or -1: the latest checkpoint */
     double stop_at;               /* --stop-at T, or INFINITY */
+    int keys;                     /* --keys: list the case keys (mps_case_print_keys) */
 };
 
 /* Parses argv. extra (may be NULL) is an array of nextra options, filled in
  * place. "--help" prints usage (with the extras' help) to stdout and returns
- * MPS_EINTR so main can exit 0 after it. */
+ * MPS_EINTR so main can exit 0 after it; "--keys" sets cli->keys and returns
+ * MPS_EINTR, for main to print its key tables. */
 enum mps_status mps_cli_parse(struct mps_cli *cli, int argc, char **argv,
                               struct mps_cli_extra *extra, int nextra, const char *usage,
                               struct mps_err *err);

@@ -59,6 +59,7 @@ struct mps_motion_frame {
 
 /* The motion.* keys (for mps_case_load, next to mps_case_common_keys). */
 extern const struct mps_key_spec mps_motion_keys[];
+#define MPS_MOTION_KEYS_TITLE "Every program: the tank's motion (`motion.*`)"
 
 /* Reads and checks the motion block (a table file is read and fitted here).
  * *out is allocated for every kind, none included. Errors name the file, line

@@ -1359,8 +1359,14 @@ static int read_command_line(int argc, char **argv, struct mps_cli *cli,
         "       coupler --restart DIR [--from TIME] [--set end_time=T] [--quiet]";
     struct mps_err err = {0};
     enum mps_status st = mps_cli_parse(cli, argc, argv, opt, NOPTS, usage, &err);
-    if (st == MPS_EINTR)
-        return 0;
+    if (st == MPS_EINTR) {
+        if (cli->keys) {
+            const char *const titles[COUPLER_NTABLES] = {
+                MPS_CASE_COMMON_KEYS_TITLE, "coupler: `coupling.*`", MPS_MOTION_KEYS_TITLE};
+            mps_case_print_keys(stdout, coupler_case_tables, titles, COUPLER_NTABLES);
+        }
+        return 0; /* --help, --version, --keys */
+    }
     if (st) {
         fprintf(stderr, "coupler: %s\n", err.msg);
         return mps_status_exit_code(st);

@@ -274,13 +274,16 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
     return MPS_OK;
 }
 
-/* Loads the case (validated against the keys this program knows) and
- * builds the fluid and its outputs. */
+/* The keys this program knows (the solid's and the coupler's sections are
+ * theirs to check) */
+static const struct mps_key_spec *const case_tables[] = {mps_case_common_keys, fluid_case_keys,
+                                                         mps_motion_keys};
+
+/* Loads the case (validated against case_tables) and builds the fluid and
+ * its outputs. */
 static enum mps_status setup(struct run *r, const char *case_path, const char *const *sets,
                              int nsets, const char *prefix, struct mps_err *err)
 {
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, fluid_case_keys,
-                                                 mps_motion_keys};
     const char *const ignore[] = {"solid.", "coupling.", NULL};
     /* standalone: this command is the run's record; under the coupler the
      * resolved case brings the coupler's */
@@ -290,7 +293,7 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
         all[nall++] = sets[k];
     if (!r->coupled)
         mps_prov_sets(all, &nall, MPS_CLI_MAX_SETS + MPS_PROV_NSETS);
-    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, tables, 3, ignore, err);
+    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, case_tables, 3, ignore, err);
     struct fluid_params prm;
     if (!st && !(st = fluid_params_read(&prm, r->cs, err)))
         st = mps_motion_read(&r->motion, r->cs, err);
@@ -561,8 +564,14 @@ int main(int argc, char **argv)
     const char *usage = "usage: fluid_solver CASE.yml --out DIR [--set key=value]... [--quiet]\n"
                         "       fluid_solver --connect ENDPOINT [--timeout S]   (under the coupler)";
     enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
-    if (st == MPS_EINTR)
-        return 0; /* --help, --version */
+    if (st == MPS_EINTR) {
+        if (cli.keys) {
+            const char *const titles[] = {MPS_CASE_COMMON_KEYS_TITLE,
+                                          "fluid_solver: `fluid.*`", MPS_MOTION_KEYS_TITLE};
+            mps_case_print_keys(stdout, case_tables, titles, 3);
+        }
+        return 0; /* --help, --version, --keys */
+    }
     if (st) {
         fprintf(stderr, "fluid_solver: %s\n", err.msg);
         return mps_status_exit_code(st);

@@ -148,8 +148,6 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
                            struct mps_err *err)
 {
     double wall_start = mps_wall_seconds();
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
-                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
     if (model_name && !solid_model_find(model_name))
         return mps_err_set(err, MPS_EINPUT, "--model %s: unknown solid model (known: %s)",
@@ -188,7 +186,7 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
                       r.mark.number);
         r.restart_time = r.disk.time;
     }
-    st = mps_case_load(&c, case_path, sets, nsets, tables, 3, ignore, err);
+    st = mps_case_load(&c, case_path, sets, nsets, solid_case_tables, SOLID_NTABLES, ignore, err);
     if (st != MPS_OK) {
         mps_ckpt_free(&r.disk);
         return st;
@@ -388,8 +386,15 @@ int main(int argc, char **argv)
         {"--model", 1, "solid model (default: the case's solid.model)", NULL},
     };
     enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
-    if (st == MPS_EINTR)
-        return 0; /* --help, --version */
+    if (st == MPS_EINTR) {
+        if (cli.keys) {
+            const char *const titles[SOLID_NTABLES] = {
+                MPS_CASE_COMMON_KEYS_TITLE, "solid_solver: `solid.*` (both models, `mps` and `tlsph`)",
+                MPS_MOTION_KEYS_TITLE};
+            mps_case_print_keys(stdout, solid_case_tables, titles, SOLID_NTABLES);
+        }
+        return 0; /* --help, --version, --keys */
+    }
     if (st == MPS_OK)
         st = run(&cli, extra[0].value, &err);
     if (st != MPS_OK)

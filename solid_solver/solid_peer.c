@@ -70,8 +70,6 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     struct peer *p = self;
     snprintf(p->out, sizeof p->out, "%s", out);
     snprintf(p->prefix, sizeof p->prefix, "%s", prefix);
-    const struct mps_key_spec *const tables[] = {mps_case_common_keys, solid_case_keys,
-                                                 mps_motion_keys};
     const char *const ignore[] = {"fluid.", "coupling.", NULL};
     /* --model NAME is solid.model, so the snapshots' /config says what runs */
     char model_set[64];
@@ -79,7 +77,8 @@ static enum mps_status configure(void *self, const char *case_path, const char *
     if (p->ops)
         snprintf(model_set, sizeof model_set, "solid.model=%s", p->ops->name);
     enum mps_status st =
-        mps_case_load(&p->cs, case_path, sets, p->ops ? 1 : 0, tables, 3, ignore, err);
+        mps_case_load(&p->cs, case_path, sets, p->ops ? 1 : 0, solid_case_tables, SOLID_NTABLES,
+                      ignore, err);
     /* the solid owns its keys: a problem with one, or across them, is a case
      * error, which the coupler prints as its own (PROTOCOL.md 8); what the
      * model then cannot do is a plain input error of this solver */

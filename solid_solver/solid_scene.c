@@ -96,6 +96,9 @@ const struct mps_key_spec solid_case_keys[] = {
     {.name = NULL},
 };
 
+const struct mps_key_spec *const solid_case_tables[SOLID_NTABLES] = {
+    mps_case_common_keys, solid_case_keys, mps_motion_keys};
+
 void solid_scene_lattice(const struct solid_scene *s, int b, long *nx, long *ny)
 {
     const struct solid_body_def *d = &s->bodies[b];

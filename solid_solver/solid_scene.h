@@ -86,6 +86,10 @@ struct solid_scene {
 
 /* The solid keys ("solid.*"), for mps_case_load (with mps_case_common_keys). */
 extern const struct mps_key_spec solid_case_keys[];
+/* What the solid validates a case against, standalone and coupled: the
+ * common keys, its own and the tank's motion */
+#define SOLID_NTABLES 3
+extern const struct mps_key_spec *const solid_case_tables[SOLID_NTABLES];
 
 /* Reads and checks the scene (a body with no particles, an empty clamp, a
  * clamp naming an unknown body are errors naming the key). */

@@ -10,11 +10,17 @@ unheard), a standalone solid that "finished" at once with exit 0 when its
 step count overflowed, and keys whose absurd values ran into NaN or a
 non-finite PPE (docs/security.md, "Broken case files").
 
+The key lists are written out below, each key in a case that has it; every
+number key the programs list (`PROGRAM --keys`) must be in one of them, so a
+key added to a program without being added here fails this test.
+
 usage: sweep_numbers.py BIN_DIR [--jobs N] [--deadline S]
 """
 import argparse
 import concurrent.futures
+import fnmatch
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -32,7 +38,7 @@ FLUID = ['fluid.rho', 'fluid.nu', 'fluid.courant', 'fluid.dt_max', 'fluid.dt_min
          'fluid.tension_solves', 'fluid.tension_sweeps', 'fluid.collision_distance',
          'fluid.collision_restitution', 'fluid.jitter.amplitude', 'fluid.jitter.seed',
          'fluid.shifting', 'fluid.shifting_max', 'fluid.ppe_max_iter', 'fluid.ppe_drop',
-         'fluid.ppe_coarse_cell', 'fluid.tank.width', 'fluid.tank.height',
+         'fluid.ppe_coarse_cell', 'fluid.ppe_rtol', 'fluid.tank.width', 'fluid.tank.height',
          'fluid.tank.wall_layers', 'fluid.droplet_neighbours', 'fluid.blocks.0.x0',
          'fluid.blocks.0.y0', 'fluid.blocks.0.x1', 'fluid.blocks.0.y1', 'fluid.probes.0.x',
          'fluid.probes.0.y']
@@ -43,6 +49,7 @@ SOLID = ['solid.courant', 'solid.plane_factor', 'solid.refine', 'solid.mps.dampi
          'solid.bodies.0.vy', 'solid.clamps.0.x0', 'solid.clamps.0.y0', 'solid.clamps.0.x1',
          'solid.clamps.0.y1', 'solid.probes.0.x', 'solid.probes.0.y']
 COUPLING = ['coupling.hello_timeout', 'coupling.ready_timeout', 'coupling.step_timeout',
+            'coupling.tcp_port',
             'coupling.implicit.relaxation', 'coupling.implicit.tolerance',
             'coupling.implicit.abs_tolerance', 'coupling.implicit.max_iterations',
             'coupling.implicit.reuse', 'coupling.implicit.filter']
@@ -63,6 +70,11 @@ RUNS = [
     ('solid_solver', 'cases/cantilever_beam/case.yml',
      ['end_time=0.002', 'solid.model=tlsph'], ['solid.tlsph.alpha', 'solid.tlsph.hourglass']),
     ('coupler', 'cases/sloshing_low/case.yml', ['dp=0.004', 'end_time=0.01'], MOTION),
+    ('coupler', 'cases/sloshing_high/case.yml', ['dp=0.004', 'end_time=0.01', 'motion.kind=table'],
+     ['motion.table.scale', 'motion.table.knot_spacing']),
+    # the dam break's fifth probe is its wall's pressure transducer
+    ('fluid_solver', 'cases/dambreak/case.yml', ['dp=0.008', 'end_time=0.02'],
+     ['fluid.probes.4.diameter']),
     # the coupler's own event loop, with a solid alone
     ('coupler', 'cases/cantilever_beam/case.yml', ['end_time=0.002'], COMMON),
 ]
@@ -99,6 +111,23 @@ def one(bin_dir, out_root, deadline, prog, case, base, key, value):
     return tag, None
 
 
+def unswept(bin_dir):
+    """The number keys some program lists (--keys) that no run sweeps; a
+    list item's key ("fluid.blocks.*.x0") is swept by any item's."""
+    swept = {key for _, _, _, keys in RUNS for key in keys}
+    listed = set()
+    for prog in ('coupler', 'fluid_solver', 'solid_solver'):
+        p = subprocess.run([os.path.join(bin_dir, prog), '--keys'], capture_output=True,
+                           text=True, timeout=60)
+        if p.returncode != 0:
+            sys.exit(f'sweep_numbers: {prog} --keys: exit {p.returncode}: {p.stderr.strip()}')
+        listed |= set(re.findall(r'^- `([^`]+)` \((?:number|integer)\b', p.stdout, re.M))
+    if not listed:
+        sys.exit('sweep_numbers: no number key in the programs\' --keys lists')
+    return sorted(k for k in listed
+                  if not any(fnmatch.fnmatchcase(s, k.replace('*', '[0-9]*')) for s in swept))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument('bin_dir')
@@ -106,6 +135,11 @@ def main():
     ap.add_argument('--deadline', type=float, default=DEADLINE,
                     help='seconds a run may take (more for a sanitizer build)')
     a = ap.parse_args()
+    missing = unswept(a.bin_dir)
+    if missing:
+        print(f'FAIL  number keys the programs list that no run here sweeps: '
+              f'{", ".join(missing)}: add each to a run of a case that has it')
+        return 1
     out_root = tempfile.mkdtemp(prefix='sweep_numbers_')
     jobs = [(prog, case, base, key, v) for prog, case, base, keys in RUNS
             for key in keys for v in VALUES]

@@ -519,6 +519,45 @@ static void expect_abort(const struct mps_case *c, int which)
     CHECK(WIFSIGNALED(status) && WTERMSIG(status) == SIGABRT);
 }
 
+/* --keys: every key of every table, once, with its type, default, bounds and
+ * help, under its table's title */
+static void test_print_keys(void)
+{
+    char *text = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&text, &len);
+    CHECK(f != NULL);
+    const char *const titles[] = {"Common", "Test"};
+    mps_case_print_keys(f, tables, titles, 2);
+    CHECK(fclose(f) == 0);
+    const char *want[] = {
+        "## Common\n\n- `dp` (number, m, required, > 0): initial particle spacing\n",
+        "\n\n## Test\n\n- `fluid.rho` (number, kg/m^3, default 1000, > 0): fluid density\n",
+        "- `fluid.c0` (number, m/s, no default: off when absent, > 0): speed of sound\n",
+        "- `fluid.alpha` (number, default 0.1, in [0, 0.5)): damping\n",
+        "- `fluid.nsteps` (integer, default 10, in [1, 1000]): steps\n",
+        "- `fluid.verbose` (true/false, default no): chatty\n",
+        "- `fluid.gradient` (one of `corrected`, `plain`, default corrected): pressure gradient\n",
+        "- `fluid.blocks.*.x0` (number, m, required): block left edge\n",
+        "- `probes.*` (text, no default: off when absent): probe name\n",
+        "- `fluid.table` (file path): a file\n",
+    };
+    for (size_t k = 0; k < sizeof want / sizeof *want; k++) {
+        if (!strstr(text, want[k]))
+            fprintf(stderr, "test_print_keys: missing %s", want[k]);
+        CHECK(strstr(text, want[k]) != NULL);
+    }
+    int lines = 0;
+    for (const char *c = text; *c; c++)
+        lines += (*c == '\n' && c[1] == '-');
+    int nspecs = 0;
+    for (int t = 0; t < 2; t++)
+        for (const struct mps_key_spec *sp = tables[t]; sp->name; sp++)
+            nspecs++;
+    CHECK(lines == nspecs);
+    free(text);
+}
+
 static void test_aborts(void)
 {
     struct mps_err err;
@@ -539,6 +578,7 @@ int main(void)
     test_ignore();
     test_utf8();
     test_round_trip();
+    test_print_keys();
     test_aborts();
     for (int i = 0; i < ntmp; i++)
         remove(tmp_paths[i]);

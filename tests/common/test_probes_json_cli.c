@@ -270,6 +270,14 @@ static void test_cli(void)
     fflush(stdout);
     CHECK(parse(&cli, ex, 3, &err, help) == MPS_EINTR);
 
+    /* --keys wins as --help does (no case file needed) and says so for main
+     * to print its tables */
+    const char *keys[] = {"--out", "--keys", NULL};
+    mps_err_clear(&err);
+    CHECK(parse(&cli, ex, 3, &err, keys) == MPS_EINTR);
+    CHECK(cli.keys == 1);
+    CHECK(parse(&cli, ex, 3, &err, ok3) == MPS_OK && cli.keys == 0);
+
     const char *dashdash[] = {"--quiet", "--", "--odd-name.yml", NULL};
     CHECK(parse(&cli, ex, 3, &err, dashdash) == MPS_OK);
     CHECK_STR(cli.case_path, "--odd-name.yml");
