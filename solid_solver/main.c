@@ -389,8 +389,8 @@ int main(int argc, char **argv)
     if (st == MPS_EINTR) {
         if (cli.keys) {
             const char *const titles[SOLID_NTABLES] = {
-                MPS_CASE_COMMON_KEYS_TITLE, "solid_solver: `solid.*` (both models, `mps` and `tlsph`)",
-                MPS_MOTION_KEYS_TITLE};
+                MPS_CASE_COMMON_KEYS_TITLE,
+                "solid_solver: `solid.*` (both models, `mps` and `tlsph`)", MPS_MOTION_KEYS_TITLE};
             mps_case_print_keys(stdout, solid_case_tables, titles, SOLID_NTABLES);
         }
         return 0; /* --help, --version, --keys */

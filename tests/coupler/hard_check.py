@@ -7,7 +7,12 @@ usage: hard_check.py RUN_DIR --end T [--tip-bound B] [--max-iterations-mean N]
                      [--rigid RIGID_RUN EI LO HI] [--compare OTHER_RUN RMS]
                      [--still-load H1 H2 DP TOL T0 T1] [--fewer-iterations OTHER_RUN F]
 
-Stable: the coupler ended normally at time T and |tip_dx| stayed below B (m).
+Stable: the coupler ended normally at time T, |tip_dx| stayed below B (m),
+and at most 5% of the water was thrown over the tank's walls (the fluid's
+lost_particles: the stiff and the rigid plate, stable by every other
+measure, throw 1.8-2.0% at 3 mm, the flow's own splash; explicit light
+plates that held to T by flinging the water out lost 4-95%, which the tip
+bound and the status did not see: docs/hard_cases.md, section 1).
 --max-iterations-mean: the implicit coupling's mean iterations per step.
 --static LO HI T0 T1: the mean tip_dx over [T0, T1] lies in [LO, HI] (m).
 --drift D T0 T1 T2 T3: |mean over [T2, T3] - mean over [T0, T1]| <= D (m).
@@ -33,6 +38,8 @@ import os
 import sys
 
 import numpy as np
+
+LOST_MAX = 0.05  # of the water: see the docstring
 
 
 def read_probes(run):
@@ -72,6 +79,18 @@ def main():
         why += f'; |tip_dx| reached {np.max(np.abs(tip)):.4f} m > {a.tip_bound} m'
     else:
         why += f'; max |tip_dx| {np.max(np.abs(tip)):.4f} m'
+    fs_path = os.path.join(a.run, 'fluid_summary.json')
+    fs = json.load(open(fs_path)) if os.path.exists(fs_path) else {}
+    lost = int(fs.get('lost_particles') or 0)
+    water = lost + int((fs.get('particles') or {}).get('fluid', 0))
+    if not water:
+        stable = False
+        why += '; no fluid_summary.json: the water is not known'
+    elif lost > LOST_MAX * water:
+        stable = False
+        why += f'; {lost} of {water} water particles thrown over the walls (more than {LOST_MAX:.0%})'
+    else:
+        why += f'; {lost} of {water} water particles lost'
     print(('ok    ' if stable else 'note  ') + 'stable: ' + why)
     if a.expect_unstable:
         if stable:
