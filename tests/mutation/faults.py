@@ -809,13 +809,13 @@ FAULTS = [
     # ---- case files: bad input (common/mps_case*.c) ----
     F(id='case_bounds_unchecked', eq='bad input: ranges', file='common/mps_case_keys.c',
       old='''        if (!in_bounds(s, v->d)) {
-            bounds_text(s, prob, np);
+            case_bounds_text(s, prob, np);
             return -1;
         }
         return 0;
     case MPS_KEY_INT:''',
       new='''        if (0 && !in_bounds(s, v->d)) {
-            bounds_text(s, prob, np);
+            case_bounds_text(s, prob, np);
             return -1;
         }
         return 0;
