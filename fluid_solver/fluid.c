@@ -170,7 +170,7 @@ enum mps_status fluid_create(struct fluid **out, const struct fluid_params *prm,
         }
         f->side_wall_rate = sqrt(2.0 * prm->nu * omega) / prm->side_wall_breadth;
         if (prm->side_wall_inertia)
-            f->side_wall_inertia = sqrt(2.0 * prm->nu / omega) / prm->side_wall_breadth;
+            f->side_wall_inertia = delta / prm->side_wall_breadth;
     }
     f->rho_inertial = prm->rho * (1.0 + f->side_wall_inertia);
     if (fluid_scene_build(prm, &pts, &nf, &nw)) {

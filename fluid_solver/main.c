@@ -278,6 +278,7 @@ static enum mps_status run_standalone(struct run *r, struct mps_err *err)
  * theirs to check) */
 static const struct mps_key_spec *const case_tables[] = {mps_case_common_keys, fluid_case_keys,
                                                          mps_motion_keys};
+#define NTABLES (int)(sizeof case_tables / sizeof *case_tables)
 
 /* Loads the case (validated against case_tables) and builds the fluid and
  * its outputs. */
@@ -293,7 +294,7 @@ static enum mps_status setup(struct run *r, const char *case_path, const char *c
         all[nall++] = sets[k];
     if (!r->coupled)
         mps_prov_sets(all, &nall, MPS_CLI_MAX_SETS + MPS_PROV_NSETS);
-    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, case_tables, 3, ignore, err);
+    enum mps_status st = mps_case_load(&r->cs, case_path, all, nall, case_tables, NTABLES, ignore, err);
     struct fluid_params prm;
     if (!st && !(st = fluid_params_read(&prm, r->cs, err)))
         st = mps_motion_read(&r->motion, r->cs, err);
@@ -566,9 +567,10 @@ int main(int argc, char **argv)
     enum mps_status st = mps_cli_parse(&cli, argc, argv, extra, 1, usage, &err);
     if (st == MPS_EINTR) {
         if (cli.keys) {
-            const char *const titles[] = {MPS_CASE_COMMON_KEYS_TITLE,
-                                          "fluid_solver: `fluid.*`", MPS_MOTION_KEYS_TITLE};
-            mps_case_print_keys(stdout, case_tables, titles, 3);
+            const char *const titles[NTABLES] = {MPS_CASE_COMMON_KEYS_TITLE,
+                                                 "fluid_solver: `fluid.*`",
+                                                 MPS_MOTION_KEYS_TITLE};
+            mps_case_print_keys(stdout, case_tables, titles, NTABLES);
         }
         return 0; /* --help, --version, --keys */
     }

@@ -48,6 +48,18 @@ def read_probes(run):
                              names=True)
 
 
+def water_lost(run):
+    """(lost, started) water particles of a run, from its fluid_summary.json;
+    (0, 0) without one. bench/hard_cases.py judges its runs by this too."""
+    path = os.path.join(run, 'fluid_summary.json')
+    if not os.path.exists(path):
+        return 0, 0
+    with open(path) as f:
+        fs = json.load(f)
+    lost = int(fs.get('lost_particles') or 0)
+    return lost, lost + int((fs.get('particles') or {}).get('fluid', 0))
+
+
 def running_mean(t, y, width):
     k = max(1, int(round(width / np.median(np.diff(t)))))
     return np.convolve(y, np.ones(k) / k, mode='same')
@@ -79,10 +91,7 @@ def main():
         why += f'; |tip_dx| reached {np.max(np.abs(tip)):.4f} m > {a.tip_bound} m'
     else:
         why += f'; max |tip_dx| {np.max(np.abs(tip)):.4f} m'
-    fs_path = os.path.join(a.run, 'fluid_summary.json')
-    fs = json.load(open(fs_path)) if os.path.exists(fs_path) else {}
-    lost = int(fs.get('lost_particles') or 0)
-    water = lost + int((fs.get('particles') or {}).get('fluid', 0))
+    lost, water = water_lost(a.run)
     if not water:
         stable = False
         why += '; no fluid_summary.json: the water is not known'
