@@ -24,13 +24,16 @@ static inline double mps_weight_r2(double r2, double re)
     return 0.5 * (w + fabs(w)); /* max(w, 0), exact, and compiled without a jump */
 }
 
-/* Eq. 10's pair factor w(r) / r^2 for a pair closer than r_floor (r2 <
- * r_floor^2, r2 > 0): w(r_floor) / (r_floor r), the pair read at r_floor in
- * its own direction (dx / r) and at its own speed. The callers keep their
- * own arithmetic for the pairs outside, so a run without such a pair is the
- * same to the bit with or without the floor. Why: w / r^2 grows as 1 / r^3,
- * and the pressure that answers one close pair's approach throws it apart
- * (docs/pressure.md, "Pairs closer than half a spacing"). */
+/* The pair factor w(r) / r^2 of Eq. 10 and of the gradients (Eq. 9, 14-15)
+ * for a pair closer than r_floor (r2 < r_floor^2, r2 > 0): w(r_floor) /
+ * (r_floor r), the pair read at r_floor in its own direction (dx / r) and at
+ * its own speed or pressure difference. The callers keep their own
+ * arithmetic for the pairs outside, so a run without such a pair is the same
+ * to the bit with or without the floor. Why: w / r^2 grows as 1 / r^3; in
+ * Eq. 10 the pressure that answers one close pair's approach throws it apart
+ * (docs/pressure.md, "Pairs closer than half a spacing"), in the gradient a
+ * few pascals across a pair at 0.02 dp throw it apart at metres per second
+ * (docs/hard_cases.md, section 4). */
 static inline double mps_divergence_floor_factor(double r2, double re, double r_floor)
 {
     return (re / r_floor - 1.0) / (r_floor * sqrt(r2));

@@ -203,10 +203,11 @@ static double grad_ref(const struct mps_ops_in *in, size_t i, const double *f, i
 /* Sums over the neighbours of i: g = sum (f_j - ref) e_ij / r w, and, if m is
  * not NULL, m = sum e_ij (x) e_ij w and the sum of weights. */
 static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, double ref,
-                        double g[MPS_DIM], double m[MPS_DIM][MPS_DIM])
+                        double r_floor, double g[MPS_DIM], double m[MPS_DIM][MPS_DIM])
 {
     const struct mps_nbr_list *nl = in->nl;
-    const double re2 = in->re * in->re;
+    const double re2 = in->re * in->re, rf2 = r_floor * r_floor;
+    const double w_floor = r_floor > 0.0 ? in->re / r_floor - 1.0 : 0.0;
     double wsum = 0.0;
     for (int a = 0; a < MPS_DIM; a++) {
         g[a] = 0.0;
@@ -224,6 +225,10 @@ static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, 
         /* one division: w / r^2 = (re / r - 1) / r^2 from 1 / r. Divisions
          * bound this loop (it had one per term of m). */
         double ir = 1.0 / sqrt(r2), w = in->re * ir - 1.0, wr2 = w * ir * ir;
+        if (r2 < rf2) { /* the pair read at r_floor: w / r^2 -> w(r_f) / (r_f r) */
+            w = w_floor;
+            wr2 = mps_divergence_floor_factor(r2, in->re, r_floor);
+        }
         double s = (f[j] - ref) * wr2; /* (f_j-ref)/r * e * w = (f_j-ref) dx w / r^2 */
         for (int a = 0; a < MPS_DIM; a++)
             g[a] += s * dx[a];
@@ -237,7 +242,7 @@ static double grad_sums(const struct mps_ops_in *in, size_t i, const double *f, 
 }
 
 void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, int use_min,
-                      double (*grad)[MPS_DIM])
+                      double r_floor, double (*grad)[MPS_DIM])
 {
     const struct mps_nbr_list *nl = in->nl;
     const double coef = MPS_DIM / n0;
@@ -246,15 +251,15 @@ void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, i
         if (!QUERY(in, i))
             continue;
         double g[MPS_DIM];
-        grad_sums(in, i, f, grad_ref(in, i, f, use_min), g, NULL);
+        grad_sums(in, i, f, grad_ref(in, i, f, use_min), r_floor, g, NULL);
         for (int a = 0; a < MPS_DIM; a++)
             grad[i][a] = coef * g[a];
     }
 }
 
 void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const double *f,
-                                int use_min, double cond_floor, double (*grad)[MPS_DIM],
-                                unsigned char *fallback)
+                                int use_min, double cond_floor, double r_floor,
+                                double (*grad)[MPS_DIM], unsigned char *fallback)
 {
     const struct mps_nbr_list *nl = in->nl;
     const double coef = MPS_DIM / n0;
@@ -267,7 +272,7 @@ void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const do
             continue;
         double g[2], m[2][2];
         double ref = grad_ref(in, i, f, use_min);
-        double wsum = grad_sums(in, i, f, ref, g, m);
+        double wsum = grad_sums(in, i, f, ref, r_floor, g, m);
         double det = 0.0;
         if (wsum > 0.0) {
             /* Eq. 14-15: A = M^-1 with M normalised by n_i; the 1/n_i of the

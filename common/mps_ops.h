@@ -40,9 +40,12 @@ void mps_ops_laplacian(const struct mps_ops_in *in, double n0, double lambda, co
 
 /* Eq. 9: grad_i = d/n0 sum_j (f_j - fref_i) r_ij / |r_ij|^2 w(r_ij), with
  * fref_i = f_i, or with use_min the minimum of f over i and its neighbours
- * (Koshizuka's stabilised form: only repulsive pair terms). */
+ * (Koshizuka's stabilised form: only repulsive pair terms). A pair closer
+ * than r_floor (m; 0: none) is read at r_floor in its own direction
+ * (mps_divergence_floor_factor), in both gradients: the pairs outside keep
+ * their arithmetic to the bit. */
 void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, int use_min,
-                      double (*grad)[MPS_DIM]);
+                      double r_floor, double (*grad)[MPS_DIM]);
 
 /* Eq. 14-15: the gradient with the correction matrix A_i, exact for linear f
  * wherever the neighbourhood spans every direction. Where A_i is singular or
@@ -50,8 +53,8 @@ void mps_ops_gradient(const struct mps_ops_in *in, double n0, const double *f, i
  * typically at a free surface), falls back to Eq. 9 for that particle and
  * sets fallback[i] = 1 (fallback may be NULL). */
 void mps_ops_gradient_corrected(const struct mps_ops_in *in, double n0, const double *f,
-                                int use_min, double cond_floor, double (*grad)[MPS_DIM],
-                                unsigned char *fallback);
+                                int use_min, double cond_floor, double r_floor,
+                                double (*grad)[MPS_DIM], unsigned char *fallback);
 
 /* Eq. 10: div_i = d/n0 sum_j (f_j - f_i).r_ij / |r_ij|^2 w(r_ij), a pair
  * closer than r_floor (m; 0: none) read at r_floor

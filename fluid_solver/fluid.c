@@ -881,10 +881,11 @@ enum mps_status fluid_step(struct fluid *f, double dt, struct mps_err *err)
         g_in.pair_use = f->shadow_use;
     }
     if (p->gradient == FLUID_GRAD_CORRECTED)
-        mps_ops_gradient_corrected(&g_in, f->n0, f->p, p->gradient_min, 0.2, f->grad,
-                                   f->fallback);
+        mps_ops_gradient_corrected(&g_in, f->n0, f->p, p->gradient_min, 0.2,
+                                   p->gradient_floor * p->dp, f->grad, f->fallback);
     else
-        mps_ops_gradient(&g_in, f->n0, f->p, p->gradient_min, f->grad);
+        mps_ops_gradient(&g_in, f->n0, f->p, p->gradient_min, p->gradient_floor * p->dp,
+                         f->grad);
     const double c = dt / f->rho_inertial;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < nf; i++)

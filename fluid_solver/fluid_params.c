@@ -80,6 +80,12 @@ const struct mps_key_spec fluid_case_keys[] = {
      "closes, and a pair a long step had brought to 0.32 dp asked for 290 kPa and threw a "
      "particle out at 27 m/s (docs/pressure.md, \"Pairs closer than half a spacing\"). "
      "0: Eq. 10 as printed"},
+    {"fluid.gradient_floor", MPS_KEY_DOUBLE, "0.5", 0, 1, MPS_KEY_HI_OPEN, NULL, "dp",
+     "a pair closer than this enters the pressure gradient (Eq. 9, and Eq. 14-15's "
+     "matrix) as at this distance, in its own direction: Eq. 7's weight grows without "
+     "bound as a pair closes, and a water particle 0.018 dp from a plate's surface "
+     "particle left at 10 m/s in one step (docs/hard_cases.md, section 4). 0: Eq. 9 as "
+     "printed"},
     {"fluid.initial_pressure", MPS_KEY_ENUM, "hydrostatic", 0, 0, 0, "hydrostatic|zero", "",
      "pressure at t = 0: hydrostatic below the top of the water above each particle, or zero"},
     {"fluid.density_weight", MPS_KEY_ENUM, "mps", 0, 0, 0, "mps|quadratic", "",
@@ -376,6 +382,7 @@ enum mps_status fluid_params_read(struct fluid_params *p, const struct mps_case 
         strcmp(mps_case_string(c, "fluid.divergence_stencil"), "near_bodies") == 0;
     p->divergence_slip = strcmp(mps_case_string(c, "fluid.divergence_walls"), "slip") == 0;
     p->divergence_floor = mps_case_double(c, "fluid.divergence_floor");
+    p->gradient_floor = mps_case_double(c, "fluid.gradient_floor");
     p->initial_hydrostatic =
         strcmp(mps_case_string(c, "fluid.initial_pressure"), "hydrostatic") == 0;
     p->re_n = mps_case_double(c, "fluid.re_n");

@@ -66,6 +66,7 @@ struct fluid_params {
     int divergence_near_bodies;   /* ... only in the rows that reach a solid body */
     int divergence_slip;          /* its Eq. 10 with the tank's walls slipping */
     double divergence_floor;      /* fraction of dp: closer pairs read there in Eq. 10 */
+    double gradient_floor;        /* fraction of dp: closer pairs read there in Eq. 9/14 */
     int initial_hydrostatic;      /* start from the hydrostatic pressure of each block */
     double kappa, alpha;          /* Eq. 23 relaxation; compressibility 1/(rho c^2), 1/Pa */
     double kappa_dt;              /* s: steps shorter than this correct kappa dt / kappa_dt */

@@ -1475,6 +1475,59 @@ static void test_divergence_floor(void)
     fluid_destroy(&f);
 }
 
+/* fluid.gradient_floor (0.5 dp, the default) on the solver's step: the 10
+ * mm still-water tank after 10 steps, the water particle above the floor's
+ * middle put 0.02 dp from the floor's nearest wall particle (across the
+ * floor's face, where a creeping particle ends: the refined plate at rest,
+ * docs/hard_cases.md section 4), at rest, and one more step. Eq. 7's weight
+ * there is re / r - 1 = 104 and the corrected gradient falls back to Eq. 9:
+ * as printed the pair's term throws the particle off at tens of m/s; read at
+ * half a spacing it leaves slower than anything in this water could move.
+ * Both runs are the same up to that step, so the difference is the floor's. */
+static void test_gradient_floor(void)
+{
+    const char *sets[] = {"dp=0.01", "fluid.gradient_floor=0"}; /* the default, then off */
+    double speed[2] = {0.0, 0.0};
+    for (int pass = 0; pass < 2; pass++) {
+        struct fluid *f = make_stepped("cases/hydrostatic/case.yml", sets, pass + 1, 10);
+        if (!f)
+            return;
+        const struct fluid_params *p = &f->prm;
+        CHECK(p->gradient_floor == (pass == 0 ? 0.5 : 0.0));
+        const size_t i = nearest_fluid(f, 0.5 * p->tank_w, 0.5 * p->dp);
+        size_t j = f->nfluid;
+        double best = INFINITY;
+        for (size_t k = f->nfluid; k < f->nfixed_end; k++) {
+            double d2 = pow(f->x[k][0] - f->x[i][0], 2) + pow(f->x[k][1] - f->x[i][1], 2);
+            if (d2 < best) {
+                best = d2;
+                j = k;
+            }
+        }
+        const int id = f->id[i];
+        for (int d = 0; d < MPS_DIM; d++) {
+            f->x[i][d] = f->x[j][d] + 0.02 * p->dp * (f->x[i][d] - f->x[j][d]) / sqrt(best);
+            f->v[i][d] = 0.0;
+        }
+        CHECK(step(f, 1e-3) == MPS_OK);
+        size_t k = 0;
+        while (k < f->nfluid && f->id[k] != id)
+            k++;
+        CHECK(k < f->nfluid);
+        if (k < f->nfluid)
+            speed[pass] = hypot(f->v[k][0], f->v[k][1]);
+        printf("gradient floor %.1f dp: a water particle put 0.02 dp from the floor's wall "
+               "particle leaves at %.4g m/s\n", p->gradient_floor, speed[pass]);
+        fluid_destroy(&f);
+    }
+    /* sqrt(2 g h), 2.4 m/s: the speed of a particle that fell the whole 0.3 m
+     * of this still water, more than any of it can have (it moves at 1e-4
+     * m/s, fluid_still_water_default_10s) */
+    const double v_fall = sqrt(2.0 * 9.81 * 0.3);
+    CHECK(speed[0] < v_fall);
+    CHECK(speed[1] > v_fall); /* as printed: the throw the floor is for */
+}
+
 /* fluid.divergence_walls = slip: still water in the 10 mm tank moved as a
  * whole along the floor, v* = (0.5, 0) m/s for the fluid, the tank at rest.
  * The fluid is moved 0.3 dp along the floor off the wall's lattice. With the
@@ -1701,6 +1754,7 @@ int main(int argc, char **argv)
     test_divergence_stencil();
     test_divergence_slip();
     test_divergence_floor();
+    test_gradient_floor();
     test_verlet_list();
     test_surface_double_check();
     test_surface_thresholds_in_flow();

@@ -19,7 +19,11 @@
  *     Eq. 8's number density (the reason it exists);
  *   - Eq. 10's floor (fluid.divergence_floor): a pair closer than it reads
  *     as at it, d/n0 w(r_f) / r_f times the approach speed, whatever its
- *     distance; a pair beyond it is Eq. 10 as printed. */
+ *     distance; a pair beyond it is Eq. 10 as printed;
+ *   - the gradient's floor (fluid.gradient_floor): the same for Eq. 9's pair
+ *     term, d/n0 w(r_f) / r_f times the pressure difference, and Eq. 14-15
+ *     with the floor still exact for a linear field (the matrix is built with
+ *     the same floored weights as the sum it corrects). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -118,7 +122,7 @@ static void test_regular(void)
 
     /* Eq. 9: exact for a linear field in the interior */
     double e_plain = 0.0;
-    mps_ops_gradient(&in, cn.n0, f, 0, g);
+    mps_ops_gradient(&in, cn.n0, f, 0, 0.0, g);
     for (int k = 0; k < N; k++)
         if (interior(k, 3))
             e_plain = fmax(e_plain, hypot(g[k][0] - GX, g[k][1] - GY));
@@ -128,7 +132,7 @@ static void test_regular(void)
 
     /* the neighbourhood minimum changes nothing on a full regular lattice */
     double e_min = 0.0;
-    mps_ops_gradient(&in, cn.n0, f, 1, g);
+    mps_ops_gradient(&in, cn.n0, f, 1, 0.0, g);
     for (int k = 0; k < N; k++)
         if (interior(k, 3))
             e_min = fmax(e_min, hypot(g[k][0] - GX, g[k][1] - GY));
@@ -137,7 +141,7 @@ static void test_regular(void)
     /* Eq. 14-15: exact for a linear field everywhere, corners included */
     double e_corr = 0.0;
     int nfb = 0;
-    mps_ops_gradient_corrected(&in, cn.n0, f, 0, 0.2, g, fb);
+    mps_ops_gradient_corrected(&in, cn.n0, f, 0, 0.2, 0.0, g, fb);
     for (int k = 0; k < N; k++) {
         nfb += fb[k];
         if (!fb[k])
@@ -193,7 +197,7 @@ static void test_perturbed(double jitter)
      * both directions */
     double e_corr = 0.0;
     int nfb = 0, m = 0;
-    mps_ops_gradient_corrected(&in, cn.n0, f, 0, 0.2, g, fb);
+    mps_ops_gradient_corrected(&in, cn.n0, f, 0, 0.2, 0.0, g, fb);
     for (int k = 0; k < N; k++) {
         nfb += fb[k];
         if (!fb[k])
@@ -204,7 +208,7 @@ static void test_perturbed(double jitter)
 
     /* Eq. 9 is only first-order consistent: a bounded, non-zero error */
     double e_plain = 0.0, s_plain = 0.0;
-    mps_ops_gradient(&in, cn.n0, f, 0, g);
+    mps_ops_gradient(&in, cn.n0, f, 0, 0.0, g);
     for (int k = 0; k < N; k++)
         if (interior(k, 3)) {
             double e = hypot(g[k][0] - GX, g[k][1] - GY) / gmag;
@@ -334,6 +338,20 @@ static void test_laplacian_vec(void)
     release(&L);
 }
 
+/* The regular lattice with particle b moved to r from a along x, and the
+ * neighbour lists built again for it (re for the gradient's and Eq. 10's). */
+static void build_closed_pair(struct lattice *L, int a, int b, double r, double re)
+{
+    build(L, 0.0, 1);
+    L->x[b][0] = L->x[a][0] + r;
+    release(L); /* the lists again, with the pair closed */
+    struct mps_err err = {0};
+    const double(*x)[MPS_DIM] = (const double(*)[MPS_DIM])L->x;
+    CHECK(mps_nbr_grid_build(&L->g, N, x, 4.0 * DP, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&L->ln, &L->g, x, N, re, &err) == MPS_OK);
+    CHECK(mps_nbr_list_build(&L->ll, &L->g, x, N, 4.0 * DP, &err) == MPS_OK);
+}
+
 /* `test_fluid_ops avx512` (ctest test_fluid_ops_avx512) runs the parts that compare the
  * AVX-512 path with the portable one, and reports SKIPPED (77) where there is
  * no AVX-512 path (the CPU lacks it, or MPS_SIMD=sse2): without it those
@@ -352,16 +370,7 @@ static void test_divergence_floor(void)
     struct mps_lattice_consts cn = mps_lattice_consts(DP, re);
     for (size_t t = 0; t < sizeof r_over_dp / sizeof r_over_dp[0]; t++) {
         const double r = r_over_dp[t] * DP;
-        build(&L, 0.0, 1);
-        L.x[b][0] = L.x[a][0] + r;
-        release(&L); /* the lists again, with the pair closed */
-        struct mps_err err = {0};
-        CHECK(mps_nbr_grid_build(&L.g, N, (const double(*)[MPS_DIM])L.x, 4.0 * DP, &err) ==
-              MPS_OK);
-        CHECK(mps_nbr_list_build(&L.ln, &L.g, (const double(*)[MPS_DIM])L.x, N, re, &err) ==
-              MPS_OK);
-        CHECK(mps_nbr_list_build(&L.ll, &L.g, (const double(*)[MPS_DIM])L.x, N, 4.0 * DP, &err) ==
-              MPS_OK);
+        build_closed_pair(&L, a, b, r, re);
         memset(v, 0, sizeof v);
         v[b][0] = -u;
         struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, re, NULL, NULL, NULL};
@@ -376,6 +385,55 @@ static void test_divergence_floor(void)
                r_over_dp[t], u, floored, want, plain, want_plain);
         CHECK_NEAR(floored, want, 1e-12 * fabs(want));
         CHECK_NEAR(plain, want_plain, 1e-12 * fabs(want_plain));
+        release(&L);
+    }
+}
+
+/* One pair of the regular lattice closed to r, f = P at the second particle
+ * and 0 elsewhere: the first's Eq. 9 is that pair's term alone, d/n0 P w(r)/r
+ * along the pair, or with the floor r_f > r, d/n0 P w(r_f)/r_f; Eq. 14-15 of
+ * the linear field 3x + 2y is (3, 2) with the pair that close, floored or not. */
+static void test_gradient_floor(void)
+{
+    static struct lattice L;
+    const double P = 2000.0, rf = 0.5 * DP, re = 2.1 * DP;
+    const int a = (NY / 2) * NX + NX / 2, b = a + 1; /* neighbours along x */
+    const double r_over_dp[] = {0.02, 0.2, 0.45, 0.6, 0.9};
+    static double f[N], lin[N], g[N][MPS_DIM];
+    static unsigned char fb[N];
+    struct mps_lattice_consts cn = mps_lattice_consts(DP, re);
+    for (size_t t = 0; t < sizeof r_over_dp / sizeof r_over_dp[0]; t++) {
+        const double r = r_over_dp[t] * DP;
+        build_closed_pair(&L, a, b, r, re);
+        for (int i = 0; i < N; i++) {
+            f[i] = i == b ? P : 0.0;
+            lin[i] = 3.0 * L.x[i][0] + 2.0 * L.x[i][1];
+        }
+        struct mps_ops_in in = {&L.ln, (const double(*)[MPS_DIM])L.x, re, NULL, NULL, NULL};
+        mps_ops_gradient(&in, cn.n0, f, 0, rf, g);
+        const double floored = g[a][0], floored_y = g[a][1];
+        mps_ops_gradient(&in, cn.n0, f, 0, 0.0, g);
+        const double plain = g[a][0];
+        const double want_plain = MPS_DIM / cn.n0 * P * (re / r - 1.0) / r;
+        const double want = r < rf ? MPS_DIM / cn.n0 * P * (re / rf - 1.0) / rf : want_plain;
+        printf("Eq. 9, a pair at %.2f dp, %.0f Pa across it: %.6g Pa/m with the floor at 0.5 dp "
+               "(want %.6g), %.6g without (want %.6g)\n",
+               r_over_dp[t], P, floored, want, plain, want_plain);
+        CHECK_NEAR(floored, want, 1e-12 * fabs(want));
+        CHECK_NEAR(floored_y, 0.0, 1e-9 * fabs(want));
+        CHECK_NEAR(plain, want_plain, 1e-12 * fabs(want_plain));
+        mps_ops_gradient_corrected(&in, cn.n0, lin, 0, 0.2, rf, g, fb);
+        printf("Eq. 14-15 of 3x + 2y there, floored: (%.12g, %.12g), fallback %d\n", g[a][0],
+               g[a][1], fb[a]);
+        CHECK(!fb[a]);
+        CHECK_NEAR(g[a][0], 3.0, 1e-9);
+        CHECK_NEAR(g[a][1], 2.0, 1e-9);
+        /* Without the floor the close pair's weight takes over the matrix,
+         * whose determinant falls under the condition floor: Eq. 9 then, and
+         * the pair's term as printed (what threw the water particle). */
+        mps_ops_gradient_corrected(&in, cn.n0, lin, 0, 0.2, 0.0, g, fb);
+        printf("  without the floor: (%.12g, %.12g), fallback %d\n", g[a][0], g[a][1], fb[a]);
+        CHECK(fb[a] == (r < 0.1 * DP));
         release(&L);
     }
 }
@@ -396,5 +454,6 @@ int main(int argc, char **argv)
     test_density_disorder();
     test_laplacian_vec();
     test_divergence_floor();
+    test_gradient_floor();
     return test_summary("test_fluid_ops");
 }
