@@ -15,13 +15,15 @@ case exists). Every run goes into RUNS/NAME (coupler output, the command in
 command.txt, the load average when it started in load.txt) and is skipped
 when RUNS/NAME/summary.json exists (--force reruns). --report-only writes the
 report from the runs there are. --quick: the 6 mm runs only (for a try).
---only leaves the page alone and prints those sections' Markdown on stdout,
-without the page's title and introduction (the progress lines go to stderr):
-paste them over the page's sections, keeping the notes under their titles
-(tests/docs/doc_lint.py fails on a second title or a progress line in a
-page). Without --only the page is written: tables and plots are rewritten; the reading in docs/hard_cases.md after the
-"## Reading" line is kept. Wall times depend on the machine and its load:
-each table gives the load average at the start of its runs (os.getloadavg).
+--only leaves the page alone (not its plots in docs/img, which are written)
+and prints those sections' Markdown on stdout, without the page's title and
+introduction (the progress lines go to stderr): paste them over the page's
+sections, keeping the notes under their titles (tests/docs/doc_lint.py fails
+on a second title or a progress line in a page). Without --only the page is
+written: tables and plots are rewritten; the reading in docs/hard_cases.md
+after the "## Reading" line is kept. Wall times depend on the machine and its
+load: each table gives the load average at the start of its runs
+(os.getloadavg).
 """
 import argparse
 import glob
