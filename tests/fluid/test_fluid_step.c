@@ -107,6 +107,22 @@ static size_t nearest_fluid(const struct fluid *f, double x, double y)
     return best;
 }
 
+/* The particle of [lo, hi) other than i nearest to particle i, its squared
+ * distance in *d2 (lo if there is none, *d2 = INFINITY) */
+static size_t nearest_to(const struct fluid *f, size_t i, size_t lo, size_t hi, double *d2)
+{
+    size_t best = lo;
+    *d2 = INFINITY;
+    for (size_t k = lo; k < hi; k++) {
+        double r2 = pow(f->x[k][0] - f->x[i][0], 2) + pow(f->x[k][1] - f->x[i][1], 2);
+        if (k != i && r2 < *d2) {
+            *d2 = r2;
+            best = k;
+        }
+    }
+    return best;
+}
+
 /* The particle of each PPE row (f->row inverted), malloc'ed; NULL if out of
  * memory. */
 static size_t *row_particles(const struct fluid *f)
@@ -1387,15 +1403,8 @@ static void test_divergence_floor(void)
     const double dt = 1e-3, rf = p->divergence_floor * p->dp, re = p->re_n * p->dp;
     CHECK(p->divergence_floor == 0.5);
     const size_t i = nearest_fluid(f, 0.073, 0.146);
-    size_t j = i;
-    double best = INFINITY;
-    for (size_t k = 0; k < f->nfluid; k++) {
-        double d2 = pow(f->x[k][0] - f->x[i][0], 2) + pow(f->x[k][1] - f->x[i][1], 2);
-        if (k != i && d2 < best) {
-            best = d2;
-            j = k;
-        }
-    }
+    double best;
+    const size_t j = nearest_to(f, i, 0, f->nfluid, &best);
     const double r = 0.3 * p->dp;
     double e[MPS_DIM];
     for (int d = 0; d < MPS_DIM; d++) {
@@ -1495,15 +1504,8 @@ static void test_gradient_floor(void)
         const struct fluid_params *p = &f->prm;
         CHECK(p->gradient_floor == (pass == 0 ? 0.5 : 0.0));
         const size_t i = nearest_fluid(f, 0.5 * p->tank_w, 0.5 * p->dp);
-        size_t j = f->nfluid;
-        double best = INFINITY;
-        for (size_t k = f->nfluid; k < f->nfixed_end; k++) {
-            double d2 = pow(f->x[k][0] - f->x[i][0], 2) + pow(f->x[k][1] - f->x[i][1], 2);
-            if (d2 < best) {
-                best = d2;
-                j = k;
-            }
-        }
+        double best;
+        const size_t j = nearest_to(f, i, f->nfluid, f->nfixed_end, &best);
         const int id = f->id[i];
         for (int d = 0; d < MPS_DIM; d++) {
             f->x[i][d] = f->x[j][d] + 0.02 * p->dp * (f->x[i][d] - f->x[j][d]) / sqrt(best);
