@@ -2,11 +2,14 @@
 """Fluid solver speed: time per particle-step and its split, as N grows.
 
 usage: bench/fluid_speed.py [--bin build/bin] [--threads 1,2] [--out docs/fluid_speed.md]
+                            [--sizes DP,DP,...] [--repeat K or K,K,...]
 Runs the dam break (cases/dambreak) at spacings that give about 6k, 20k, 80k
 and 290k particles (fluid + wall + dummy) over the first 0.08 s of simulated
 time, once per thread count, and tabulates ns per particle-step by phase from
 each run's summary.json; each of these rows is the fastest of --repeat runs (3:
-a run of 80 steps at 6k particles varies by 10-15% from run to run here). Then
+a run of 80 steps at 6k particles varies by 10-15% from run to run here; a
+list gives each size its own count, e.g. 3,3,3,1 for one run of the 290k rows,
+which vary less and take a quarter of an hour each on one thread). Then
 the growth of the cost per particle-step from size to size, against N log N's.
 Also times the paper's coarsest dam break (dp = 3 mm, 4,656
 fluid particles) over 1 s of simulated time, with the case's time step and
@@ -63,25 +66,32 @@ def main():
     ap.add_argument('--threads', default='1,2')
     ap.add_argument('--out', default=os.path.join(ROOT, 'docs', 'fluid_speed.md'))
     ap.add_argument('--sizes', default='0.0035,0.0018,0.0008,0.0004')
-    ap.add_argument('--repeat', type=int, default=3)
+    ap.add_argument('--repeat', default='3',
+                    help='runs per row, the fastest kept: one count, or one per size')
     args = ap.parse_args()
+    sizes = [float(x) for x in args.sizes.split(',')]
+    repeats = [int(x) for x in args.repeat.split(',')]
+    if len(repeats) == 1:
+        repeats *= len(sizes)
+    if len(repeats) != len(sizes) or min(repeats) < 1:
+        ap.error(f'--repeat {args.repeat}: give one count >= 1, or one per size ({len(sizes)})')
     threads = [int(t) for t in args.threads.split(',')]
     phases = ['neighbours', 'predict', 'density', 'ppe_assemble', 'ppe_solve', 'correct', 'other']
     lines = ['# Fluid solver speed', '',
              'Reproduce: `bench/fluid_speed.py` (Release build, quiet 2-core machine).', '',
              'Dam break (`cases/dambreak`) over a short simulated time; N counts fluid, wall and '
              'dummy particles; ns per particle-step by phase (from `summary.json`), of the '
-             f'fastest of {args.repeat} runs.', '',
+             f'fastest of {" / ".join(map(str, repeats))} runs (per size).', '',
              '| dp (mm) | N | threads | steps | PPE iters/step | ' + ' | '.join(phases) +
              ' | total ns/particle-step |',
              '|' + '---|' * (len(phases) + 6)]
     per_size = {t: [] for t in threads}   # (N, ns per particle-step) per thread count
-    for dp in [float(s) for s in args.sizes.split(',')]:
+    for dp, repeat in zip(sizes, repeats):
         # the same window for every size: the first steps from rest take the
         # 1 ms step cap and harder PPEs, so a shorter window would not compare
         end = 0.08
         for t in threads:
-            s = min((run(args.bin, dp, end, t)[0] for _ in range(max(1, args.repeat))),
+            s = min((run(args.bin, dp, end, t)[0] for _ in range(repeat)),
                     key=lambda r: r['ns_per_particle_step'])
             n = s['particles']['total']
             ps = s['steps'] * n
