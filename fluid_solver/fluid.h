@@ -145,6 +145,11 @@ struct fluid {
     /* bookkeeping */
     double time;
     long step;
+    /* the step a restart began from (0 otherwise): the counters below and
+     * the phase timers are this process's, so its per-step figures are
+     * over step - step_start (a restarted summary read 6.4 PCG iterations
+     * a step for 12.0) */
+    long step_start;
     double dt_last;
     double dt_kappa;           /* the last step's dt_kappa (fluid.kappa_step_decay) */
     double dt_kappa_expansion; /* and its dt_kappa_expansion (..._decay_expansion) */

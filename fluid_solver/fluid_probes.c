@@ -109,10 +109,14 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
     mps_json_int(j, "solid", (long long)(f->ps.n - f->nfixed_end));
     mps_json_int(j, "total", (long long)f->ps.n);
     mps_json_close(j);
+    /* steps counts from the run's start; the counters and times, and so
+     * the per-step figures, are this process's (a restart's: steps_run) */
+    const long run = f->step - f->step_start;
     mps_json_int(j, "steps", f->step);
+    mps_json_int(j, "steps_run", run);
     mps_json_num(j, "simulated_time", f->time);
     mps_json_int(j, "ppe_iterations", f->ppe_iterations);
-    mps_json_num(j, "ppe_iterations_per_step", f->step ? (double)f->ppe_iterations / f->step : 0);
+    mps_json_num(j, "ppe_iterations_per_step", run > 0 ? (double)f->ppe_iterations / run : 0);
     mps_json_int(j, "neighbour_builds", f->nbr_rebuilds);
     mps_json_int(j, "lost_particles", f->lost);
     mps_json_int(j, "wall_guard_uses", f->wall_guard);
@@ -138,7 +142,7 @@ void fluid_summary(const struct fluid *f, struct mps_json *j)
     double total = mps_timer_total(&f->timer);
     mps_json_num(j, "step_seconds", total);
     mps_json_num(j, "ns_per_particle_step",
-                 f->step ? 1e9 * total / ((double)f->step * (double)f->ps.n) : 0.0);
+                 run > 0 ? 1e9 * total / ((double)run * (double)f->ps.n) : 0.0);
     fluid_sensors_summary(f, j);
     mps_json_object(j, "phase_seconds");
     for (int k = 0; k < f->timer.nphases; k++)

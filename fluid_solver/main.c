@@ -167,6 +167,7 @@ static void summary_json(const struct run *r, FILE *fp, enum mps_status st,
         mps_json_object(&j, "restart");
         mps_json_str(&j, "checkpoint", r->restart_path);
         mps_json_num(&j, "time", r->restart_time);
+        mps_json_int(&j, "step", r->f->step_start);
         if (r->restart_arith[0])
             mps_json_str(&j, "arith_differs", r->restart_arith);
         mps_json_close(&j);
@@ -365,6 +366,7 @@ static enum mps_status restart_or_setup(struct run *r, const struct mps_cli *cli
         return mps_err_prefix(err, "%s: ", r->restart_path);
     mps_run_arith_check(&r->disk, "fluid_solver", r->restart_path, r->restart_arith,
                         sizeof r->restart_arith);
+    r->f->step_start = r->f->step;
     if (!cli->quiet)
         fprintf(stderr, "fluid_solver: restarting %s at t = %.9g s (step %ld)\n", cli->restart_dir,
                 r->f->time, r->f->step);
@@ -416,6 +418,7 @@ static enum mps_status peer_resume(void *self, long number, struct mps_err *err)
     mps_run_arith_check(&r->disk, "fluid_solver", r->restart_path, r->restart_arith,
                         sizeof r->restart_arith);
     r->restart_time = r->f->time;
+    r->f->step_start = r->f->step;
     return MPS_OK;
 }
 

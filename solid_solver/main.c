@@ -53,6 +53,7 @@ struct run {
     double stopped_at;        /* --stop-at stopped the run here, or -1 */
     char restart_path[4400];  /* the checkpoint restarted from, or "" */
     double restart_time;
+    long step_start;          /* its step: the timings are this process's steps' */
     char restart_arith[256];  /* what differs from its run's arithmetic, or "" */
 };
 
@@ -104,7 +105,9 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
     mps_prov_json(c, &j);
     mps_json_str(&j, "model", r->ops->name);
     mps_json_int(&j, "particles", (long long)n);
+    /* steps from the run's start; the timings are this process's steps' */
     mps_json_int(&j, "steps", steps);
+    mps_json_int(&j, "steps_run", steps - r->step_start);
     mps_json_num(&j, "time", t);
     mps_json_num(&j, "wall_seconds", wall_total);
     mps_json_num(&j, "step_seconds", wall_loop);
@@ -118,11 +121,12 @@ static enum mps_status write_summary(const struct run *r, const struct mps_case 
         mps_json_object(&j, "restart");
         mps_json_str(&j, "checkpoint", r->restart_path);
         mps_json_num(&j, "time", r->restart_time);
+        mps_json_int(&j, "step", r->step_start);
         if (r->restart_arith[0])
             mps_json_str(&j, "arith_differs", r->restart_arith);
         mps_json_close(&j);
     }
-    double ps = (double)n * (double)steps;
+    double ps = (double)n * (double)(steps - r->step_start);
     mps_json_num(&j, "ns_per_particle_step", ps > 0 ? 1e9 * wall_loop / ps : NAN);
     mps_json_num(&j, "particle_steps_per_second", wall_loop > 0 ? ps / wall_loop : NAN);
     mps_json_object(&j, "solid");
@@ -269,7 +273,7 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     if (cli->restart_dir) {
         /* exactly where the checkpointed run was, its next events included */
         t = r.disk.time;
-        step = r.mark.steps;
+        step = r.step_start = r.mark.steps;
         kout = r.mark.out_k;
         kprobe = r.mark.probe_k;
         kck = r.mark.ck_k;
@@ -332,8 +336,10 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     st = write_summary(&r, c, cli->out_dir, n, step, t, wall_loop,
                        mps_wall_seconds() - wall_start, err);
     if (st == MPS_OK && !cli->quiet)
-        fprintf(stderr, "solid_solver: %ld steps in %.3g s, %.1f ns per particle-step\n", step,
-                wall_loop, step > 0 ? 1e9 * wall_loop / ((double)n * (double)step) : 0.0);
+        fprintf(stderr, "solid_solver: %ld steps in %.3g s, %.1f ns per particle-step\n",
+                step - r.step_start, wall_loop,
+                step > r.step_start ? 1e9 * wall_loop / ((double)n * (double)(step - r.step_start))
+                                    : 0.0);
 done:
     mps_probes_close(&r.probes);
     mps_h5_close(&r.h5);

@@ -25,7 +25,8 @@ struct peer {
     double *probes;
     double depth;          /* interface depth, m */
     double t_output;
-    long substeps;
+    long substeps;         /* from the run's start (a restart's checkpoint holds them) */
+    long substeps_start;   /* the checkpoint's, on a restart: advances are this process's */
     double max_ratio;      /* largest sub-step / stable step seen */
     struct proto_solver_stats stats;
     double wall0;
@@ -145,7 +146,7 @@ static enum mps_status resume(void *self, long number, struct mps_err *err)
         return mps_err_prefix(err, "%s: ", p->restart_path);
     mps_run_arith_check(&p->disk, "solid_solver", p->restart_path, p->restart_arith,
                         sizeof p->restart_arith);
-    p->substeps = p->mark.steps;
+    p->substeps = p->substeps_start = p->mark.steps;
     p->restart_time = p->disk.time;
     return MPS_OK;
 }
@@ -264,13 +265,15 @@ static void summary_json(struct peer *p, FILE *fp, enum mps_status st, const str
         mps_json_object(&j, "restart");
         mps_json_str(&j, "checkpoint", p->restart_path);
         mps_json_num(&j, "time", p->restart_time);
+        mps_json_int(&j, "substeps", p->substeps_start);
         if (p->restart_arith[0])
             mps_json_str(&j, "arith_differs", p->restart_arith);
         mps_json_close(&j);
     }
     mps_json_int(&j, "substeps", p->substeps);
     mps_json_num(&j, "substeps_per_coupling_step",
-                 p->stats.advances ? (double)p->substeps / p->stats.advances : 0.0);
+                 p->stats.advances ? (double)(p->substeps - p->substeps_start) / p->stats.advances
+                                   : 0.0);
     mps_json_num(&j, "largest_substep_over_stable", p->max_ratio);
     if (p->model && p->ops->summary) {
         mps_json_object(&j, "model_summary");

@@ -15,7 +15,8 @@ the same probes.csv rows (and iterations.csv, if the run writes one) as the firs
 time/step attributes, and the XDMF indexes must be identical between
 OUT/full and OUT/cut, and so must iterations.csv and the iteration counts
 of summary.json (implicit coupling); the restart's summary.json must say
-where it restarted.
+where it restarted, and each solver's per-step figures (PCG iterations, time,
+sub-steps) must be over the steps its restarted process ran.
 --require COLUMN: the column must be > 0 at the checkpoint restarted from
 (e.g. broken_bonds: the checkpoint holds a fractured solid).
 Exit 0 if all hold, 1 with the first difference otherwise."""
@@ -77,6 +78,58 @@ def compare_h5(a, b):
                 bad = np.argwhere(x != y) if x.shape == y.shape else "shape"
                 fail("%s: field %s differs (%s)" % (b, name, bad[:3] if len(bad) else bad))
         return len(ga.keys())
+
+
+def check_rates(cut):
+    """A restarted solver's per-step figures are over the steps its process
+    ran (its counters and timers start at the restart), not over the steps
+    since the run's start: a restart from half-way once read 6.4 PCG
+    iterations a step where the run took 12.0. Returns the lines checked."""
+    said = []
+
+    def near(a, b):
+        return abs(a - b) <= 1e-9 * max(abs(a), abs(b), 1e-300)
+
+    for name in ("summary.json", "fluid_summary.json", "solid_summary.json"):
+        path = os.path.join(cut, name)
+        if not os.path.exists(path):
+            continue
+        with open(path) as f:
+            s = json.load(f)
+        rs = s.get("restart") or {}
+        if "ppe_iterations" in s:  # the fluid, alone or coupled
+            run = s.get("steps_run")
+            if run is None or "step" not in rs or run != s["steps"] - rs["step"] or run <= 0:
+                fail("%s: steps_run %r, steps %r, restart step %r: steps_run must be the steps "
+                     "after the restart" % (name, run, s["steps"], rs.get("step")))
+            if not near(s["ppe_iterations_per_step"], s["ppe_iterations"] / run):
+                fail("%s: ppe_iterations_per_step %r, not ppe_iterations / steps_run = %r"
+                     % (name, s["ppe_iterations_per_step"], s["ppe_iterations"] / run))
+            said.append("%s: %d steps run of %d, %.2f PCG iterations a step"
+                        % (name, run, s["steps"], s["ppe_iterations_per_step"]))
+        elif "substeps_per_coupling_step" in s:  # the solid, coupled
+            if "substeps" not in rs or not 0 < rs["substeps"] < s["substeps"]:
+                fail("%s: restart substeps %r against %r in all" % (name, rs.get("substeps"),
+                                                                     s["substeps"]))
+            want = (s["substeps"] - rs["substeps"]) / s["advances"]
+            if not near(s["substeps_per_coupling_step"], want):
+                fail("%s: substeps_per_coupling_step %r, not (substeps - the restart's) / "
+                     "advances = %r" % (name, s["substeps_per_coupling_step"], want))
+            said.append("%s: %.3f sub-steps an advance over %d advances"
+                        % (name, want, s["advances"]))
+        elif s.get("solver") == "solid_solver":  # the solid alone
+            run = s.get("steps_run")
+            if run is None or "step" not in rs or run != s["steps"] - rs["step"] or run <= 0:
+                fail("%s: steps_run %r, steps %r, restart step %r" % (name, run, s["steps"],
+                                                                       rs.get("step")))
+            want = 1e9 * s["step_seconds"] / (s["particles"] * run)
+            if not near(s["ns_per_particle_step"], want):
+                fail("%s: ns_per_particle_step %r, not over the steps run: %r"
+                     % (name, s["ns_per_particle_step"], want))
+            said.append("%s: %d steps run of %d" % (name, run, s["steps"]))
+    if not said:
+        fail("no solver summary with per-step figures in %s" % cut)
+    return said
 
 
 def kill_after_checkpoint(cmd, cut, half, prefix):
@@ -180,6 +233,8 @@ def main():
     rs = summ.get("restart")
     if not rs or not os.path.exists(rs["checkpoint"]) and stop != "kill":
         fail("summary.json does not record the restart: %r" % rs)
+    for line in check_rates(cut):
+        print(line)
     kept = glob.glob(os.path.join(cut, "checkpoint", "*_*.ckpt"))
     per = {}
     for k in kept:
