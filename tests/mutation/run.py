@@ -26,11 +26,12 @@ and skips the faults done, unless --redo (with --only: those faults);
 --baseline runs the baseline again (after a change to the tests). --table
 FILE writes the markdown table for docs/testing.md.
 --hints-only skips the suite's baseline and runs only each fault's hinted
-tests, on the unmodified tree first (a test failing there is left out) and
-then with the fault: minutes instead of the suite's ten, for checking new
-faults; a fault none of its hints catches is reported as survived, not run
-against the rest of the suite. Such results are marked, and a later run
-without --hints-only runs those faults again on the whole suite.
+tests, on the unmodified tree first (a test failing there is left out; each
+test once per sweep) and then with the fault: minutes instead of the suite's
+ten, for checking new faults or sweeping all of them; a fault none of its
+hints catches is reported as survived, not run against the rest of the
+suite. Such results are marked, and a later run without --hints-only runs
+those faults again on the whole suite.
 --check only verifies that every fault's text occurs once in its file.
 Exit status: 0 if every fault was caught, 1 otherwise."""
 import argparse
@@ -162,16 +163,23 @@ def alternation(names):
     return '^(' + '|'.join(re.escape(n) for n in names) + ')$'
 
 
-def run_fault(f, src, build, log, baseline_bad, all_tests, hints_only=False):
+def run_fault(f, src, build, log, baseline_bad, all_tests, hints_only=False, clean=None):
+    """clean (hints_only): {test: status} on the unmodified tree, filled as
+    tests run there, so that a test hinted by several faults runs once
+    unmodified in a sweep (the tree and its build are the same between faults)."""
     path = os.path.join(src, f['file'])
     text = open(path).read()
     if text.count(f['old']) != 1:
         return {'status': 'not applied', 'caught_by': []}
     if hints_only:  # the hinted tests' own baseline, on the unmodified tree
+        clean = {} if clean is None else clean
         hinted = [t for t in fast_tests(build) if re.search(f.get('hint', '$^'), t)]
         if not hinted:
             return {'status': 'not applied', 'caught_by': [], 'why': 'no hinted test'}
-        baseline_bad = set(failed(ctest(build, log, ['-R', alternation(hinted)])))
+        new = [t for t in hinted if t not in clean]
+        if new:
+            clean.update(ctest(build, log, ['-R', alternation(new)]))
+        baseline_bad = set(failed({t: clean.get(t, 'Not Run') for t in hinted}))
     t0 = time.time()
     try:
         with open(path, 'w') as fp:
@@ -255,6 +263,7 @@ def main():
         print(f"baseline: {base['tests']} fast tests in {base['seconds']} s; failing (left out): "
               f"{base['failed'] or 'none'}", flush=True)
     only = set(a.only.split(',')) if a.only else None
+    clean = {}   # --hints-only: each test's status on the unmodified tree, run once
     for f in FAULTS:
         if only and f['id'] not in only:
             continue
@@ -262,7 +271,7 @@ def main():
         # a fault done counts, unless only its hints ran and the suite is asked for now
         if done and not a.redo and (a.hints_only or not done.get('hints_only')):
             continue
-        r = run_fault(f, src, build, log, set(base['failed']), a.all_tests, a.hints_only)
+        r = run_fault(f, src, build, log, set(base['failed']), a.all_tests, a.hints_only, clean)
         r['revision'] = rev
         r['hints_only'] = a.hints_only
         state['faults'][f['id']] = r
