@@ -69,8 +69,14 @@ def main():
     ap.add_argument('--repeat', default='3',
                     help='runs per row, the fastest kept: one count, or one per size')
     args = ap.parse_args()
-    sizes = [float(x) for x in args.sizes.split(',')]
-    repeats = [int(x) for x in args.repeat.split(',')]
+    try:
+        sizes = [float(x) for x in args.sizes.split(',')]
+    except ValueError:
+        ap.error(f'--sizes {args.sizes}: give spacings in metres, e.g. 0.0035,0.0018')
+    try:
+        repeats = [int(x) for x in args.repeat.split(',')]
+    except ValueError:
+        ap.error(f'--repeat {args.repeat}: give one count >= 1, or one per size')
     if len(repeats) == 1:
         repeats *= len(sizes)
     if len(repeats) != len(sizes) or min(repeats) < 1:
