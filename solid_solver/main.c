@@ -335,11 +335,12 @@ static enum mps_status run(const struct mps_cli *cli, const char *model_name,
     mps_progress_finish(&prog, t, step);
     st = write_summary(&r, c, cli->out_dir, n, step, t, wall_loop,
                        mps_wall_seconds() - wall_start, err);
-    if (st == MPS_OK && !cli->quiet)
+    if (st == MPS_OK && !cli->quiet) {
+        const long steps_run = step - r.step_start; /* a restart's: the timings' */
         fprintf(stderr, "solid_solver: %ld steps in %.3g s, %.1f ns per particle-step\n",
-                step - r.step_start, wall_loop,
-                step > r.step_start ? 1e9 * wall_loop / ((double)n * (double)(step - r.step_start))
-                                    : 0.0);
+                steps_run, wall_loop,
+                steps_run > 0 ? 1e9 * wall_loop / ((double)n * (double)steps_run) : 0.0);
+    }
 done:
     mps_probes_close(&r.probes);
     mps_h5_close(&r.h5);

@@ -90,6 +90,13 @@ def check_rates(cut):
     def near(a, b):
         return abs(a - b) <= 1e-9 * max(abs(a), abs(b), 1e-300)
 
+    def steps_run(name, s, rs):
+        run = s.get("steps_run")
+        if run is None or "step" not in rs or run != s["steps"] - rs["step"] or run <= 0:
+            fail("%s: steps_run %r, steps %r, restart step %r: steps_run must be the steps "
+                 "after the restart" % (name, run, s["steps"], rs.get("step")))
+        return run
+
     for name in ("summary.json", "fluid_summary.json", "solid_summary.json"):
         path = os.path.join(cut, name)
         if not os.path.exists(path):
@@ -98,10 +105,7 @@ def check_rates(cut):
             s = json.load(f)
         rs = s.get("restart") or {}
         if "ppe_iterations" in s:  # the fluid, alone or coupled
-            run = s.get("steps_run")
-            if run is None or "step" not in rs or run != s["steps"] - rs["step"] or run <= 0:
-                fail("%s: steps_run %r, steps %r, restart step %r: steps_run must be the steps "
-                     "after the restart" % (name, run, s["steps"], rs.get("step")))
+            run = steps_run(name, s, rs)
             if not near(s["ppe_iterations_per_step"], s["ppe_iterations"] / run):
                 fail("%s: ppe_iterations_per_step %r, not ppe_iterations / steps_run = %r"
                      % (name, s["ppe_iterations_per_step"], s["ppe_iterations"] / run))
@@ -118,10 +122,7 @@ def check_rates(cut):
             said.append("%s: %.3f sub-steps an advance over %d advances"
                         % (name, want, s["advances"]))
         elif s.get("solver") == "solid_solver":  # the solid alone
-            run = s.get("steps_run")
-            if run is None or "step" not in rs or run != s["steps"] - rs["step"] or run <= 0:
-                fail("%s: steps_run %r, steps %r, restart step %r" % (name, run, s["steps"],
-                                                                       rs.get("step")))
+            run = steps_run(name, s, rs)
             want = 1e9 * s["step_seconds"] / (s["particles"] * run)
             if not near(s["ns_per_particle_step"], want):
                 fail("%s: ns_per_particle_step %r, not over the steps run: %r"

@@ -177,7 +177,8 @@ def run_fault(f, src, build, log, baseline_bad, all_tests, hints_only=False, cle
         if not hinted:
             return {'status': 'not applied', 'caught_by': [], 'why': 'no hinted test'}
         new = [t for t in hinted if t not in clean]
-        if new:
+        if new:  # the last fault's file is restored, its build not yet
+            build_tree(build, log)
             clean.update(ctest(build, log, ['-R', alternation(new)]))
         baseline_bad = set(failed({t: clean.get(t, 'Not Run') for t in hinted}))
     t0 = time.time()
@@ -204,10 +205,9 @@ def run_fault(f, src, build, log, baseline_bad, all_tests, hints_only=False, cle
         return {'status': 'caught' if caught else 'survived', 'caught_by': caught,
                 'tests_run': len(ran), 'seconds': round(time.time() - t0, 1)}
     finally:
+        # restored; the next build (its fault's, or a baseline's) rebuilds it
         with open(path, 'w') as fp:
             fp.write(text)
-        if hints_only:
-            build_tree(build, log)  # the next fault's baseline needs the clean build
 
 
 def table(results):
